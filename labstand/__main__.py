@@ -1,0 +1,5 @@
+"""python -m labstand."""
+
+from labstand.cli import entry_point
+
+entry_point()

@@ -1,0 +1,60 @@
+"""``labstand model``: properties of the model itself (linearised modes)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from typing import Any
+
+from labstand.commands.common import add_stand_options, load_stand
+from sim.modes import linear_modes
+
+
+def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
+    """Add ``labstand model``."""
+    parser = sub.add_parser("model", help="properties of the baseline model")
+    model_sub = parser.add_subparsers(dest="model_command", metavar="WHAT", required=True)
+    modes = model_sub.add_parser(
+        "modes",
+        help="linearised natural frequencies about static rest",
+        description="Linearised natural frequencies about static rest. Without --mass-kg, "
+        "one line per weight of the stand file (the paper's 3.096 and 8.131 kg).",
+    )
+    add_stand_options(modes, params=True)
+    modes.add_argument("--mass-kg", type=float, help="weight mass, kg (default: every weight)")
+    modes.add_argument("--json", action="store_true", help="print JSON (key modes_hz)")
+    modes.set_defaults(func=run_modes)
+
+
+def run_modes(args: argparse.Namespace) -> int:
+    """Print the modes for one mass or for every configured weight."""
+    config = load_stand(args)
+    masses = [args.mass_kg] if args.mass_kg is not None else sorted(config.weights_kg.values())
+    rows: list[dict[str, Any]] = []
+    for mass in masses:
+        for mode in linear_modes(config.stand_params(args.params, mass)):
+            rows.append(
+                {
+                    "mass_kg": mass,
+                    "mode": mode.name,
+                    "frequency_hz": mode.frequency_hz,
+                    "damping_ratio": mode.damping_ratio,
+                    "damped_frequency_hz": mode.damped_frequency_hz,
+                }
+            )
+    if args.json:
+        out = {
+            "params": args.params,
+            "modes_hz": [r["frequency_hz"] for r in rows],
+            "mass_kg": [r["mass_kg"] for r in rows],
+            "modes": rows,
+        }
+        print(json.dumps(out, indent=2))
+        return 0
+    print(f"Linearised modes, parameter set '{args.params}' ({config.source}):")
+    for r in rows:
+        print(
+            f"  m = {r['mass_kg']:.3f} kg  {r['mode']}: {r['frequency_hz']:.2f} Hz, "
+            f"damping ratio {r['damping_ratio']:.3f}"
+        )
+    return 0

@@ -1,0 +1,286 @@
+"""The stand configuration: a TOML file, validated key by key.
+
+The embedded ``default_stand.toml`` is the paper's stand. A user's file overlays it: it
+may change any key and add named parameter sets, friction tables and weights. Every
+invalid value is a ConfigError whose one-line message names the file, the table and the
+key (see docs/configuration.md for the keys, their units and ranges).
+"""
+
+from __future__ import annotations
+
+import copy
+import itertools
+import math
+import tomllib
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+from drivers.calibration import GaugeCalibration
+from drivers.limits import DriveLimits
+from sim.params import FrictionTable, StandParams
+
+__all__ = ["ConfigError", "ParameterSet", "StandConfig", "default_config", "load_config"]
+
+#: The drive's mechanical stroke [paper]; a configured limit beyond it is refused.
+STROKE_MAX_MM = 90.0
+DEFAULT_SOURCE = "<default stand>"
+
+
+class ConfigError(ValueError):
+    """A stand configuration that cannot be used; the message names file and key."""
+
+
+@dataclass(frozen=True)
+class ParameterSet:
+    """A named set of fibre parameters and the friction table it uses."""
+
+    name: str
+    stiffness_n_m: float
+    damping_n_s_m: float
+    friction: str  # a [friction.NAME] table, or "none"
+
+
+Check = Callable[[Any], str | None]  # returns a complaint, or None when the value is fine
+
+
+def _number(lo: float | None = None, hi: float | None = None, strict: bool = True) -> Check:
+    def check(value: Any) -> str | None:
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            return f"must be a number, got {type(value).__name__} {value!r}"
+        if not math.isfinite(value):
+            return f"must be finite, got {value}"
+        if lo is not None and (value <= lo if strict else value < lo):
+            return f"must be {'>' if strict else '≥'} {lo:g}, got {value:g}"
+        if hi is not None and value > hi:
+            return f"must be ≤ {hi:g}, got {value:g}"
+        return None
+
+    return check
+
+
+def _text(value: Any) -> str | None:
+    return None if isinstance(value, str) else f"must be a string, got {value!r}"
+
+
+def _number_list(value: Any) -> str | None:
+    if not isinstance(value, list) or len(value) < 2:
+        return f"must be a list of at least 2 numbers, got {value!r}"
+    for item in value:
+        if (msg := _number(0.0, strict=False)(item)) is not None:
+            return f"every entry {msg}"
+    return None
+
+
+POSITIVE = _number(0.0)
+NON_NEGATIVE = _number(0.0, strict=False)
+ANY_NUMBER = _number()
+
+_FIXED_TABLES: dict[str, dict[str, Check]] = {
+    "geometry": {
+        "fibre_length_m": POSITIVE,
+        "fibre_mass_kg": POSITIVE,
+        "pulley_radius_m": POSITIVE,
+        "wrap_angle_deg": _number(0.0, 360.0),
+        "incline_deg": _number(0.0, 90.0, strict=False),
+        "lateral_offset_m": NON_NEGATIVE,
+        "free_length_m": POSITIVE,
+        "gravity_m_s2": POSITIVE,
+    },
+    "weight": {"default": _text},
+    "drive": {
+        "amplitude_max_mm": _number(0.0, STROKE_MAX_MM),
+        "speed_max_m_s": POSITIVE,
+        "accel_max_m_s2": POSITIVE,
+    },
+    "acquisition": {"sample_rate_hz": POSITIVE},
+    "gauges": {
+        "force_n_per_count": POSITIVE,
+        "force_offset_n": ANY_NUMBER,
+        "position_mm_per_count": POSITIVE,
+        "position_offset_mm": ANY_NUMBER,
+    },
+}
+_PARAM_SET_KEYS: dict[str, Check] = {
+    "stiffness_n_m": POSITIVE,
+    "damping_n_s_m": NON_NEGATIVE,
+    "friction": _text,
+}
+_FRICTION_KEYS: dict[str, Check] = {
+    "speed_m_s": _number_list,
+    "mu": _number_list,
+    "v_reg_m_s": POSITIVE,
+}
+_NAMED_TABLES = {"params": _PARAM_SET_KEYS, "friction": _FRICTION_KEYS}
+
+
+@dataclass(frozen=True)
+class StandConfig:
+    """A validated stand configuration (see docs/configuration.md)."""
+
+    geometry: Mapping[str, float]
+    weights_kg: Mapping[str, float]
+    default_weight: str
+    parameter_sets: Mapping[str, ParameterSet]
+    friction_tables: Mapping[str, FrictionTable]
+    drive: DriveLimits
+    sample_rate_hz: float
+    gauges: GaugeCalibration
+    source: str
+    raw: Mapping[str, Any]
+
+    @property
+    def default_mass_kg(self) -> float:
+        """Mass of the weight a run uses unless told otherwise, kg."""
+        return self.weights_kg[self.default_weight]
+
+    def stand_params(self, params: str = "final", mass_kg: float | None = None) -> StandParams:
+        """The model's parameters for a named set and a weight mass (default weight if None)."""
+        if params not in self.parameter_sets:
+            known = ", ".join(sorted(self.parameter_sets))
+            raise ConfigError(f"{self.source}: no parameter set {params!r}; known: {known}")
+        mass = self.default_mass_kg if mass_kg is None else mass_kg
+        if not (math.isfinite(mass) and mass > 0):
+            raise ConfigError(f"mass must be > 0 kg, got {mass:g} kg")
+        pset = self.parameter_sets[params]
+        friction = None if pset.friction == "none" else self.friction_tables[pset.friction]
+        return StandParams(
+            mass_kg=mass,
+            stiffness_n_m=pset.stiffness_n_m,
+            damping_n_s_m=pset.damping_n_s_m,
+            friction=friction,
+            **self.geometry,
+        )
+
+    def to_dict(self) -> dict[str, Any]:
+        """The configuration as plain TOML-able data (for recordings' metadata)."""
+        return copy.deepcopy(dict(self.raw))
+
+
+def _complain(source: str, table: str, key: str, msg: str) -> ConfigError:
+    return ConfigError(f"{source}: [{table}] {key}: {msg}")
+
+
+def _check_table(source: str, name: str, table: Any, checks: dict[str, Check]) -> None:
+    if not isinstance(table, dict):
+        raise ConfigError(f"{source}: [{name}] must be a table, got {table!r}")
+    for key, value in table.items():
+        if key not in checks:
+            expected = ", ".join(sorted(checks))
+            raise _complain(source, name, key, f"unknown key; expected one of {expected}")
+        if (msg := checks[key](value)) is not None:
+            raise _complain(source, name, key, msg)
+    for key in checks:
+        if key not in table:
+            raise _complain(source, name, key, "missing")
+
+
+def _merge(base: dict[str, Any], over: Mapping[str, Any]) -> dict[str, Any]:
+    out = copy.deepcopy(base)
+    for key, value in over.items():
+        if isinstance(value, dict) and isinstance(out.get(key), dict):
+            out[key] = _merge(out[key], value)
+        else:
+            out[key] = copy.deepcopy(value)
+    return out
+
+
+def _friction_table(source: str, name: str, data: dict[str, Any]) -> FrictionTable:
+    speeds, mus = data["speed_m_s"], data["mu"]
+    where = f"friction.{name}"
+    if len(speeds) != len(mus):
+        raise _complain(source, where, "mu", f"needs {len(speeds)} values (one per speed)")
+    if any(b <= a for a, b in itertools.pairwise(speeds)):
+        raise _complain(source, where, "speed_m_s", f"must be strictly increasing, got {speeds}")
+    if speeds[0] <= 0:
+        raise _complain(source, where, "speed_m_s", f"must start above 0 m/s, got {speeds[0]}")
+    return FrictionTable(
+        tuple(map(float, speeds)), tuple(map(float, mus)), float(data["v_reg_m_s"])
+    )
+
+
+def config_from_dict(data: Mapping[str, Any], source: str = DEFAULT_SOURCE) -> StandConfig:
+    """Validate an overlay on the defaults and build the configuration."""
+    merged = _merge(_default_data(), data)
+    allowed = set(_FIXED_TABLES) | set(_NAMED_TABLES) | {"weights_kg"}
+    for key in merged:
+        if key not in allowed:
+            raise ConfigError(
+                f"{source}: unknown table [{key}]; expected one of {', '.join(sorted(allowed))}"
+            )
+    for name, checks in _FIXED_TABLES.items():
+        _check_table(source, name, merged[name], checks)
+    tables: dict[str, dict[str, Any]] = {}
+    for group, checks in _NAMED_TABLES.items():
+        if not isinstance(merged[group], dict):
+            raise ConfigError(f"{source}: [{group}] must be a table of named tables")
+        for name, table in merged[group].items():
+            _check_table(source, f"{group}.{name}", table, checks)
+        tables[group] = merged[group]
+    weights = merged["weights_kg"]
+    _check_table(source, "weights_kg", weights, {name: POSITIVE for name in weights})
+    default_weight = merged["weight"]["default"]
+    if default_weight not in weights:
+        msg = f"names no weight in [weights_kg] ({', '.join(sorted(weights))}): {default_weight!r}"
+        raise _complain(source, "weight", "default", msg)
+    frictions = {n: _friction_table(source, n, t) for n, t in tables["friction"].items()}
+    psets = {}
+    for name, t in tables["params"].items():
+        if t["friction"] != "none" and t["friction"] not in frictions:
+            msg = f"names no [friction.*] table (or 'none'): {t['friction']!r}"
+            raise _complain(source, f"params.{name}", "friction", msg)
+        psets[name] = ParameterSet(
+            name, float(t["stiffness_n_m"]), float(t["damping_n_s_m"]), t["friction"]
+        )
+    geometry = {k: float(v) for k, v in merged["geometry"].items()}
+    if geometry["lateral_offset_m"] >= geometry["free_length_m"]:
+        msg = "must be shorter than free_length_m (the fibre cannot reach the weight)"
+        raise _complain(source, "geometry", "lateral_offset_m", msg)
+    drive = merged["drive"]
+    gauges = merged["gauges"]
+    return StandConfig(
+        geometry=geometry,
+        weights_kg={k: float(v) for k, v in weights.items()},
+        default_weight=default_weight,
+        parameter_sets=psets,
+        friction_tables=frictions,
+        drive=DriveLimits(
+            amplitude_max_m=drive["amplitude_max_mm"] / 1e3,
+            speed_max_m_s=float(drive["speed_max_m_s"]),
+            accel_max_m_s2=float(drive["accel_max_m_s2"]),
+        ),
+        sample_rate_hz=float(merged["acquisition"]["sample_rate_hz"]),
+        gauges=GaugeCalibration(**{k: float(v) for k, v in gauges.items()}),
+        source=source,
+        raw=merged,
+    )
+
+
+def _default_data() -> dict[str, Any]:
+    text = resources.files("sim").joinpath("default_stand.toml").read_text(encoding="utf-8")
+    return tomllib.loads(text)
+
+
+def default_config() -> StandConfig:
+    """The paper's stand."""
+    return config_from_dict({})
+
+
+def load_config(path: str | Path | None) -> StandConfig:
+    """Load a stand file overlaid on the defaults; None gives the defaults."""
+    if path is None:
+        return default_config()
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise ConfigError(f"{p}: no such stand file") from None
+    except (OSError, UnicodeDecodeError) as err:
+        raise ConfigError(f"{p}: cannot read stand file: {err}") from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as err:
+        raise ConfigError(f"{p}: not valid TOML: {err}") from None
+    return config_from_dict(data, str(p))
