@@ -18,7 +18,6 @@ Parameter vector layout (one row per parameter set) is given by the P_* indices.
 
 from __future__ import annotations
 
-import numpy as np
 from numba import njit, prange
 
 P_MASS, P_PROJ, P_STIFF, P_DAMP, P_FRICTION_N, P_GRAVITY_N, P_PRELOAD, P_VREG = range(8)
@@ -157,18 +156,14 @@ def _step(u, v, taut, x0, xd, h, p, knots, coef):  # type: ignore[no-untyped-def
 
 
 @njit(cache=True, error_model="numpy")
-def simulate_into(x, dt, substeps, p, knots, coef, out_u, out_v, out_t):  # type: ignore[no-untyped-def]
-    """Integrate one parameter set over the drive samples x (relative to rest), in place.
+def advance_into(x, dt, substeps, p, knots, coef, u, v, taut, out_u, out_v, out_t):  # type: ignore[no-untyped-def]
+    """Integrate from state (u, v, taut) at x[0] over the samples x[1:], in place.
 
-    Starts at static rest (u = 0, v = 0, taut with δ = δ₀). Time is i·dt, never summed.
+    Writes the state after each sample into out_*[i + 1] and returns the final state, so
+    a long run can be advanced block by block (the simulated stand does). Time is i·dt,
+    never summed.
     """
     n = p[P_PROJ]
-    u = 0.0
-    v = 0.0
-    taut = True
-    out_u[0] = 0.0
-    out_v[0] = 0.0
-    out_t[0] = p[P_STIFF] * (p[P_PRELOAD] + x[0])
     h = dt / substeps
     for i in range(x.shape[0] - 1):
         xd = (x[i + 1] - x[i]) / dt
@@ -181,6 +176,19 @@ def simulate_into(x, dt, substeps, p, knots, coef, out_u, out_v, out_t):  # type
             out_t[i + 1] = t if t > 0.0 else 0.0
         else:
             out_t[i + 1] = 0.0
+    return u, v, taut
+
+
+@njit(cache=True, error_model="numpy")
+def simulate_into(x, dt, substeps, p, knots, coef, out_u, out_v, out_t):  # type: ignore[no-untyped-def]
+    """Integrate one parameter set over the drive samples x (relative to rest), in place.
+
+    Starts at static rest (u = 0, v = 0, taut with δ = δ₀).
+    """
+    out_u[0] = 0.0
+    out_v[0] = 0.0
+    out_t[0] = p[P_STIFF] * (p[P_PRELOAD] + x[0])
+    advance_into(x, dt, substeps, p, knots, coef, 0.0, 0.0, True, out_u, out_v, out_t)
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
@@ -189,4 +197,3 @@ def simulate_batch_into(x, dt, substeps, params, knots, coef, out_u, out_v, out_
     for b in prange(params.shape[0]):
         xb = x[b] if x.shape[0] > 1 else x[0]
         simulate_into(xb, dt, substeps, params[b], knots, coef, out_u[b], out_v[b], out_t[b])
-

@@ -18,7 +18,14 @@ from sim.params import FrictionTable, StandParams
 
 FloatArray = NDArray[np.float64]
 
-__all__ = ["BatchResult", "SimResult", "SimulationError", "simulate", "simulate_batch"]
+__all__ = [
+    "BatchResult",
+    "ModelStream",
+    "SimResult",
+    "SimulationError",
+    "simulate",
+    "simulate_batch",
+]
 
 #: RK4 steps per sample interval; 1 at 2 kHz meets the 0.1 % accuracy bound (see tests).
 DEFAULT_SUBSTEPS = 1
@@ -155,3 +162,63 @@ def simulate_rows(
         x2, 1.0 / rate_hz, substeps, np.ascontiguousarray(rows), knots, coef, u, v, f
     )
     return BatchResult(np.arange(n) / rate_hz, u, v, f)
+
+
+class ModelStream:
+    """The baseline model advanced block by block, for a simulated stand in real time.
+
+    Starts at static rest with the drive at ``x0_m``; each ``advance`` takes the drive
+    positions of the next samples and returns the weight displacement and fibre force at
+    them. Results equal one ``simulate`` call over the concatenated blocks.
+    """
+
+    def __init__(
+        self,
+        params: StandParams,
+        rate_hz: float,
+        x0_m: float = 0.0,
+        substeps: int = DEFAULT_SUBSTEPS,
+    ) -> None:
+        self.params = params
+        self.rate_hz = rate_hz
+        self._row = param_vector(params)
+        self._knots, self._coef = friction_arrays(params.friction)
+        self._substeps = substeps
+        self._x0 = x0_m
+        self._last_x = x0_m
+        self._state: tuple[float, float, bool] = (0.0, 0.0, True)
+
+    @property
+    def velocity_m_s(self) -> float:
+        """Weight velocity after the last sample, m/s."""
+        return self._state[1]
+
+    def advance(self, x_m: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """Weight displacement u (m) and fibre force F (N) at the next len(x_m) samples."""
+        block = np.ascontiguousarray(x_m, dtype=np.float64)
+        if block.ndim != 1 or not np.all(np.isfinite(block)):
+            raise SimulationError("drive positions must be a finite 1-D block")
+        x = np.empty(block.shape[0] + 1)
+        x[0] = self._last_x
+        x[1:] = block
+        x -= self._x0
+        n = x.shape[0]
+        u, v, f = np.empty(n), np.empty(n), np.empty(n)
+        u0, v0, taut0 = self._state
+        self._state = kernel.advance_into(
+            x,
+            1.0 / self.rate_hz,
+            self._substeps,
+            self._row,
+            self._knots,
+            self._coef,
+            u0,
+            v0,
+            taut0,
+            u,
+            v,
+            f,
+        )
+        if block.shape[0]:
+            self._last_x = float(block[-1])
+        return u[1:], f[1:]
