@@ -101,6 +101,8 @@ _FIXED_TABLES: dict[str, dict[str, Check]] = {
         "force_offset_n": ANY_NUMBER,
         "position_mm_per_count": POSITIVE,
         "position_offset_mm": ANY_NUMBER,
+        "drive_mm_per_count": POSITIVE,
+        "drive_offset_mm": ANY_NUMBER,
     },
 }
 _PARAM_SET_KEYS: dict[str, Check] = {
