@@ -15,11 +15,12 @@ from collections.abc import Sequence
 from drivers.limits import LimitError
 from labstand import __version__
 from labstand.errors import CommandError, ExitCode
+from recordings.errors import RecordingError
 from sim.config import ConfigError
 from sim.model import SimulationError
 
 #: Sub-command modules, in the order ``--help`` lists them.
-COMMANDS = ["simulate", "model"]
+COMMANDS = ["simulate", "model", "stand_sim", "replay", "compare", "table1"]
 
 log = logging.getLogger("labstand")
 
@@ -43,7 +44,7 @@ def _error_code(err: Exception) -> ExitCode:
         return err.code
     if isinstance(err, LimitError):
         return ExitCode.REFUSED
-    if isinstance(err, ConfigError | SimulationError | ValueError):
+    if isinstance(err, ConfigError | SimulationError | RecordingError | ValueError):
         return ExitCode.USAGE
     return ExitCode.FAILURE
 
@@ -61,7 +62,15 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("labstand: interrupted", file=sys.stderr)
         return ExitCode.INTERRUPTED
-    except (CommandError, LimitError, ConfigError, SimulationError, OSError, ValueError) as err:
+    except (
+        CommandError,
+        LimitError,
+        ConfigError,
+        SimulationError,
+        RecordingError,
+        OSError,
+        ValueError,
+    ) as err:
         if args.verbose:
             log.exception("command failed")
         prefix = "refused" if isinstance(err, LimitError) else "error"

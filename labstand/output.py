@@ -4,13 +4,17 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
+
 from drivers.signals import DriveProfile
 from labstand.errors import CommandError, ExitCode
+from recordings.convert import write_streams
 from recordings.csvio import write_csv
+from recordings.schema import COMMAND_DTYPE, GAUGES_DTYPE, Backend, make_metadata
 from sim.config import StandConfig
 from sim.model import SimResult
 
-SUFFIXES = (".csv",)
+SUFFIXES = (".csv", ".mcap", ".h5", ".hdf5")
 
 
 def write_simulation(
@@ -21,12 +25,41 @@ def write_simulation(
     profile: DriveProfile,
     situation: str | None,
 ) -> None:
-    """Write a simulated run; the suffix picks the format."""
+    """Write a simulated run; the suffix picks the format.
+
+    CSV holds the four columns; MCAP and HDF5 a full recording (backend ``simulate``):
+    the gauges stream is the model's output with ``seq`` 0..N−1 and ``t_ns`` = i·(1/rate),
+    the command stream is the drive position x.
+    """
     suffix = path.suffix.lower()
     if suffix == ".csv":
         write_csv(path, result.t_s, result.x_m * 1e3, result.u_m * 1e3, result.force_n)
         return
-    raise CommandError(
-        f"{path}: unknown output format {suffix!r}; use one of {', '.join(SUFFIXES)}",
-        ExitCode.USAGE,
+    if suffix not in SUFFIXES:
+        raise CommandError(
+            f"{path}: unknown output format {suffix!r}; use one of {', '.join(SUFFIXES)}",
+            ExitCode.USAGE,
+        )
+    rate = config.sample_rate_hz
+    n = result.t_s.shape[0]
+    index = np.arange(n, dtype=np.int64)
+    gauges = np.zeros(n, dtype=GAUGES_DTYPE)
+    gauges["seq"] = index
+    gauges["t_ns"] = index * round(1e9 / rate)
+    gauges["x_mm"] = result.x_m * 1e3
+    gauges["u_mm"] = result.u_m * 1e3
+    gauges["force_n"] = result.force_n
+    command = np.empty(n, dtype=COMMAND_DTYPE)
+    command["t_ns"] = gauges["t_ns"]
+    command["x_cmd_mm"] = gauges["x_mm"]
+    what = f"situation {situation}" if situation else str(profile.spec.shape)
+    metadata = make_metadata(
+        config.to_dict(),
+        Backend.SIMULATE,
+        sample_rate_hz=rate,
+        signal=profile.spec.to_dict(),
+        operator_note=f"labstand simulate: {what}, parameter set {params!r}",
     )
+    end_ns = int(gauges["t_ns"][-1])
+    events = [(0, "start", what), (end_ns, "stop", "end of simulation")]
+    write_streams(path, metadata, gauges, command, events=events)

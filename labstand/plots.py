@@ -4,7 +4,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from recordings.replay import ReplayResult
 from sim.model import SimResult
+
+_UNITS = {"u": "weight u [mm]", "F": "fibre force F [N]", "F_dyn": "dynamic force F − T₀ [N]"}
 
 
 def plot_run(path: Path, result: SimResult, title: str) -> None:
@@ -37,6 +40,49 @@ def plot_run(path: Path, result: SimResult, title: str) -> None:
     axes[2].legend(loc="upper right")
     for ax in axes:
         ax.grid(alpha=0.3)
+    fig.suptitle(title)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def plot_replay(
+    path: Path,
+    result: ReplayResult,
+    title: str,
+    second_label: str = "simulated",
+    first_label: str = "recorded",
+) -> None:
+    """Recorded vs simulated u and F − T₀ (like the paper's figures), with the residuals."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    channels = ("u", "F_dyn")
+    fig, axes = plt.subplots(
+        4,
+        1,
+        sharex=True,
+        figsize=(11, 9),
+        constrained_layout=True,
+        gridspec_kw={"height_ratios": [3, 1, 3, 1]},
+    )
+    t = result.t_s
+    for k, name in enumerate(channels):
+        ax, res_ax = axes[2 * k], axes[2 * k + 1]
+        rec, sim = result.recorded[name], result.simulated[name]
+        m = result.metrics[name]
+        ax.plot(t, rec, color="k", lw=0.9, label=first_label)
+        ax.plot(t, sim, color="tab:red", lw=0.9, ls="--", label=second_label)
+        ax.set_ylabel(_UNITS[name])
+        ax.set_title(f"{name}: R = {m.R:.4f}, ψ = {m.psi:.3g}, NRMSE = {m.nrmse:.3f}", fontsize=9)
+        ax.legend(loc="upper right", fontsize=8)
+        res_ax.plot(t, sim - rec, color="tab:purple", lw=0.7)
+        res_ax.axhline(0, color="k", lw=0.4)
+        res_ax.set_ylabel("residual")
+    for ax in axes:
+        ax.grid(alpha=0.3)
+    axes[-1].set_xlabel("time [s]")
     fig.suptitle(title)
     fig.savefig(path, dpi=110)
     plt.close(fig)

@@ -1,0 +1,79 @@
+"""``labstand replay``: a recording's drive motion through the model, compared per channel."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from collections.abc import Mapping
+from pathlib import Path
+
+from labstand.plots import plot_replay
+from labstand.recording_stand import params_for
+from recordings import open_recording
+from recordings.metrics import ChannelMetrics
+from recordings.replay import replay
+
+
+def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
+    """Add ``labstand replay``."""
+    parser = sub.add_parser(
+        "replay",
+        help="feed a recording's drive motion into the model and compare",
+        description="Feed the recording's measured drive position into the baseline model "
+        "and compare simulated with recorded u, F and F − T0 (R, psi = (1 − R)^2, NRMSE).",
+    )
+    parser.add_argument("recording", type=Path, help="recording (.mcap, .h5, .csv, .tdms)")
+    parser.add_argument(
+        "--params",
+        default="final",
+        help="parameter set (starting, final, ...) or a stand FILE.toml whose 'final' set "
+        "is used (default: final)",
+    )
+    parser.add_argument(
+        "--stand",
+        type=Path,
+        metavar="FILE",
+        help="stand file (default: the one stored in the recording)",
+    )
+    parser.add_argument("--mass-kg", type=float, help="weight mass, kg (default: the recording's)")
+    parser.add_argument("--json", action="store_true", help="print JSON (channels.u.R, ...)")
+    parser.add_argument("--plot", type=Path, metavar="PNG", help="recorded vs simulated + residual")
+    parser.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Replay and report."""
+    recording = open_recording(args.recording)
+    params, name = params_for(recording, args.stand, args.params, args.mass_kg)
+    result = replay(recording.frame(), params)
+    out = {
+        "recording": str(args.recording),
+        "params": name,
+        "mass_kg": params.mass_kg,
+        **result.to_dict(),
+    }
+    if args.plot is not None:
+        plot_replay(
+            args.plot,
+            result,
+            f"{args.recording.name}: replay with '{name}'",
+            second_label="simulated",
+        )
+        out["plot"] = str(args.plot)
+    if args.json:
+        print(json.dumps(out, indent=2))
+        return 0
+    print(f"Replay of {args.recording} with parameters '{name}', m = {params.mass_kg:g} kg:")
+    print_metrics(result.metrics)
+    for note in result.notes:
+        print(f"  note: {note}")
+    if args.plot is not None:
+        print(f"  wrote {args.plot}")
+    return 0
+
+
+def print_metrics(metrics: Mapping[str, ChannelMetrics]) -> None:
+    """A small table of R, psi and NRMSE per channel."""
+    print(f"  {'channel':8s} {'R':>10s} {'psi':>10s} {'NRMSE':>10s}")
+    for name, m in metrics.items():
+        print(f"  {name:8s} {m.R:10.6f} {m.psi:10.3g} {m.nrmse:10.4f}")
