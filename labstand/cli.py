@@ -20,7 +20,20 @@ from sim.config import ConfigError
 from sim.model import SimulationError
 
 #: Sub-command modules, in the order ``--help`` lists them.
-COMMANDS = ["simulate", "model", "stand_sim", "replay", "compare", "table1"]
+COMMANDS = [
+    "simulate",
+    "model",
+    "stand_sim",
+    "replay",
+    "compare",
+    "table1",
+    "info",
+    "import_",
+    "convert",
+    "recover",
+    "diagnose",
+    "diagnose_check",
+]
 
 log = logging.getLogger("labstand")
 

@@ -1,0 +1,155 @@
+"""The diagnosis as an HTML page with plots a person reads at a glance."""
+
+from __future__ import annotations
+
+import html
+import json
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+
+from recordings.diagnosis import Diagnosis, Trace
+from recordings.diagnosis.traces import PHASES
+
+PHASE_COLOURS = {"rise": "tab:red", "hold": "tab:orange", "fall": "tab:blue", "rest": "tab:gray"}
+
+
+def _pyplot():  # type: ignore[no-untyped-def]
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _residual_plot(path: Path, traces: Sequence[Trace], result: Diagnosis) -> None:
+    plt = _pyplot()
+    fig, axes = plt.subplots(2 * len(traces), 1, figsize=(11, 3.2 * len(traces)), squeeze=False,
+                             constrained_layout=True)
+    for i, (tr, out) in enumerate(zip(traces, result.outputs_before, strict=True)):
+        t = np.arange(tr.samples) / tr.rate_hz
+        for j, (name, rec, sim, unit) in enumerate(
+            (("u", tr.u_m * 1e3, out.u_m * 1e3, "mm"), ("F", tr.force_n, out.force_n, "N"))
+        ):
+            ax = axes[2 * i + j, 0]
+            res = np.where(tr.present, sim - rec, np.nan)
+            for k, phase in enumerate(PHASES):
+                sel = tr.phase == k
+                ax.scatter(t[sel], res[sel], s=0.4, color=PHASE_COLOURS[phase], label=phase)
+            held = ~tr.train
+            ax.fill_between(t, np.nanmin(res), np.nanmax(res), where=held, color="k", alpha=0.06,
+                            label="held out")
+            ax.set_ylabel(f"{name} residual [{unit}]")
+            ax.set_title(f"{tr.name}: fitted baseline − recorded", fontsize=9)
+            ax.grid(alpha=0.3)
+            if i == 0 and j == 0:
+                ax.legend(markerscale=12, fontsize=8, ncol=5, loc="upper right")
+    axes[-1, 0].set_xlabel("time [s]")
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+
+
+def _ranking_plot(path: Path, result: Diagnosis) -> None:
+    plt = _pyplot()
+    names = [r["effect"] for r in result.ranking]
+    screening = [r["screening"] for r in result.ranking]
+    scores = [r["score"] if r["score"] is not None else 0.0 for r in result.ranking]
+    fig, ax = plt.subplots(figsize=(9, 4), constrained_layout=True)
+    y = np.arange(len(names))[::-1]
+    ax.barh(y + 0.2, screening, height=0.4, color="tab:gray", label="screening (residual share)")
+    ax.barh(y - 0.2, scores, height=0.4, color="tab:green", label="held-out gap closure (refitted)")
+    ax.set_yticks(y, names)
+    ax.axvline(0.3, color="k", ls=":", lw=0.8, label="closure needed")
+    ax.set_xlim(min(0.0, *scores) - 0.05, 1.05)
+    ax.legend(fontsize=8, loc="lower right")
+    ax.set_title(f"Ranking — answer: {result.effect}")
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+
+
+def _overlay_plot(path: Path, traces: Sequence[Trace], result: Diagnosis) -> None:
+    plt = _pyplot()
+    fig, axes = plt.subplots(2 * len(traces), 1, figsize=(11, 3.2 * len(traces)), squeeze=False,
+                             constrained_layout=True)
+    for i, tr in enumerate(traces):
+        t = np.arange(tr.samples) / tr.rate_hz
+        before, after = result.outputs_before[i], result.outputs_after[i]
+        for j, (name, rec, b, a) in enumerate((
+            ("u [mm]", tr.u_m * 1e3, before.u_m * 1e3, after.u_m * 1e3),
+            ("F [N]", tr.force_n, before.force_n, after.force_n),
+        )):
+            ax = axes[2 * i + j, 0]
+            ax.plot(t, rec, color="k", lw=0.8, label="recorded")
+            ax.plot(t, b, color="tab:blue", lw=0.8, ls="--", label="baseline (fitted)")
+            if result.effect != "none":
+                ax.plot(t, a, color="tab:red", lw=0.8, ls=":", label=f"+ {result.effect}")
+            ax.set_ylabel(name)
+            ax.set_title(tr.name, fontsize=9)
+            ax.grid(alpha=0.3)
+            if i == 0 and j == 0:
+                ax.legend(fontsize=8, loc="upper right")
+    axes[-1, 0].set_xlabel("time [s]")
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+
+
+def _table(rows: dict[str, object]) -> str:
+    cells = "".join(
+        f"<tr><th>{html.escape(str(k))}</th><td>{_fmt(v)}</td></tr>" for k, v in rows.items()
+    )
+    return f"<table>{cells}</table>"
+
+
+def _fmt(value: object) -> str:
+    if isinstance(value, float):
+        return f"{value:.4g}"
+    if isinstance(value, dict):
+        return ", ".join(f"{html.escape(str(k))} {_fmt(v)}" for k, v in value.items())
+    return html.escape(str(value))
+
+
+def write_report(directory: Path, traces: Sequence[Trace], result: Diagnosis) -> Path:
+    """Write index.html, its PNGs and result.json into directory; returns index.html."""
+    directory.mkdir(parents=True, exist_ok=True)
+    _residual_plot(directory / "residual.png", traces, result)
+    _ranking_plot(directory / "ranking.png", result)
+    _overlay_plot(directory / "overlay.png", traces, result)
+    data = result.to_dict()
+    (directory / "result.json").write_text(json.dumps(data, indent=2))
+    where = data["where"]
+    ranking_rows = "".join(
+        f"<tr><td>{html.escape(r['effect'])}</td><td>{_fmt(r['score'])}</td>"
+        f"<td>{_fmt(r['screening'])}</td><td>{_fmt(r['params'])}</td></tr>"
+        for r in data["ranking"]
+    )
+    page = f"""<!doctype html>
+<html><head><meta charset="utf-8"><title>labstand diagnosis: {html.escape(result.effect)}</title>
+<style>body{{font-family:sans-serif;max-width:1150px;margin:auto}} td,th{{padding:2px 8px;
+text-align:left}} table{{border-collapse:collapse;margin:6px 0}} tr:nth-child(even){{background:#f3f3f3}}</style>
+</head><body>
+<h1>Diagnosis: <code>{html.escape(result.effect)}</code></h1>
+<p>Recordings: {", ".join(html.escape(t.name) for t in traces)}.
+Held-out error {result.heldout_error_before:.4g} → {result.heldout_error_after:.4g}
+(noise floor {result.noise_floor:.4g}; gap closure {result.gap_closure:.2f};
+bootstrap confidence {result.confidence:.2f}).</p>
+<h2>How far the gap shrinks (held-out cycles)</h2>
+<h3>before</h3>{_table(data["gap_before"])}<h3>after</h3>{_table(data["gap_after"])}
+<h2>Which effect</h2><img src="ranking.png" alt="ranking">
+<table><tr><th>effect</th><th>held-out gap closure</th><th>screening</th><th>fitted parameters</th></tr>
+{ranking_rows}</table>
+<h2>Where the gap lies</h2>
+<p>Shares of the fitted baseline's squared residual.</p>
+<h3>by channel</h3>{_table(where["channel"])}
+<h3>by phase of the drive motion</h3>{_table(where["phase"])}
+<h3>by regime</h3>{_table(where["regime"])}
+<h3>by frequency band</h3>{_table(where["band"])}
+<img src="residual.png" alt="residual over time coloured by phase">
+<h2>Recorded, baseline and augmented model</h2><img src="overlay.png" alt="overlay">
+<h2>Fitted baseline</h2>{_table(data["baseline_fit"])}
+</body></html>
+"""
+    index = directory / "index.html"
+    index.write_text(page, encoding="utf-8")
+    return index

@@ -1,0 +1,170 @@
+"""The check on withheld effects: generate campaigns whose truth is known, diagnose them
+blind, and score the answers.
+
+For every effect and for ``none``, at each weight mass, a campaign is drawn: a "real"
+stand (stiffness, damping and friction scale off nominal by up to ±25 %), the effect at
+a random magnitude within its plausible range, realistic gauge noise, hum and
+quantisation, and noise on the drive encoder too. Three recordings — a quick, a medium
+and a slow drive motion — are simulated with that truth. The diagnosis sees only the
+recordings (as DataFrames, like files read back) and the nominal stand.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from drivers.signals import Shape, SignalSpec, plan_motion
+from recordings.diagnosis.diagnose import diagnose
+from recordings.diagnosis.heldout import Outputs, heldout_error
+from recordings.diagnosis.traces import Trace, make_trace
+from sim.config import StandConfig
+from sim.effects import EFFECTS, EffectSpec, simulate_augmented
+from sim.effects.realism import MeasurementNoise, NoiseSpec, draw_real_stand
+
+log = logging.getLogger(__name__)
+
+CLASSES = ["none", *EFFECTS]
+MASSES_KG = (3.096, 8.131)
+#: Drive encoder noise on x, m rms (the model is driven by the *measured* x).
+DRIVE_NOISE_M = 1e-6
+
+#: (name, signal): quick, medium and slow motions (paper-like; ~22 s in all).
+FULL_CAMPAIGN = (
+    ("quick", SignalSpec(Shape.TRAPEZOIDAL, 0.025, 2.0, cycles=5, ramp_fraction=0.4)),
+    ("medium", SignalSpec(Shape.TRAPEZOIDAL, 0.025, 1.25, cycles=4, ramp_fraction=0.4)),
+    ("slow", SignalSpec(Shape.QUASI_SINUSOIDAL, 0.060, 0.5, cycles=3)),
+)
+#: A shorter campaign for the test suite (~9 s).
+SMALL_CAMPAIGN = (
+    ("quick", SignalSpec(Shape.TRAPEZOIDAL, 0.025, 2.0, cycles=4, ramp_fraction=0.4, dwell_end_s=0.5)),
+    ("slow", SignalSpec(Shape.QUASI_SINUSOIDAL, 0.060, 0.5, cycles=2, dwell_end_s=0.5)),
+)
+
+
+@dataclass(frozen=True)
+class Case:
+    """One blind diagnosis and its truth."""
+
+    truth: str
+    mass_kg: float
+    answer: str
+    truth_params: dict[str, float]
+    shrink: float
+    oracle_shrink: float
+    seconds: float
+
+
+@dataclass
+class CheckResult:
+    """Scores of a check run (see to_dict for the JSON keys)."""
+
+    cases: list[Case] = field(default_factory=list)
+
+    def to_dict(self) -> dict[str, Any]:
+        """accuracy, false_alarm_rate, confusion, median_shrink, oracle_median_shrink, ..."""
+        labels = CLASSES
+        confusion = {t: dict.fromkeys(labels, 0) for t in labels}
+        for c in self.cases:
+            confusion[c.truth][c.answer] += 1
+        n = len(self.cases)
+        correct = [c for c in self.cases if c.answer == c.truth]
+        nones = [c for c in self.cases if c.truth == "none"]
+        effects_ok = [c for c in correct if c.truth != "none"]
+        return {
+            "cases": n,
+            "accuracy": len(correct) / n if n else 0.0,
+            "false_alarm_rate": (
+                sum(c.answer != "none" for c in nones) / len(nones) if nones else 0.0
+            ),
+            "confusion": confusion,
+            "median_shrink": float(np.median([c.shrink for c in effects_ok])) if effects_ok else 0.0,
+            "oracle_median_shrink": (
+                float(np.median([c.oracle_shrink for c in effects_ok])) if effects_ok else 0.0
+            ),
+            "median_seconds": float(np.median([c.seconds for c in self.cases])) if n else 0.0,
+            "details": [c.__dict__ for c in self.cases],
+        }
+
+
+def make_campaign(
+    stand: StandConfig,
+    truth: str,
+    mass_kg: float,
+    rng: np.random.Generator,
+    campaign: Sequence[tuple[str, SignalSpec]] = FULL_CAMPAIGN,
+) -> tuple[list[Trace], list[Outputs], dict[str, float]]:
+    """Recordings of a drawn "real" stand with the effect ``truth`` (or none).
+
+    Returns the traces (what the diagnosis sees), the true noise-free outputs (the
+    oracle), and the true effect parameters.
+    """
+    nominal = stand.stand_params("final", mass_kg)
+    real = draw_real_stand(nominal, rng)
+    effects: list[EffectSpec] = []
+    params: dict[str, float] = {}
+    if truth != "none":
+        spec = EFFECTS[truth].draw(rng)
+        effects = [spec]
+        params = dict(spec.params)
+    noise = NoiseSpec.draw(rng)
+    traces, oracle = [], []
+    for name, signal in campaign:
+        t, x = plan_motion(signal, stand.drive).sample(stand.sample_rate_hz)
+        run = simulate_augmented(x, stand.sample_rate_hz, real, effects)
+        gauges = MeasurementNoise(noise, stand.sample_rate_hz, rng)
+        u_rec, f_rec = gauges.apply(run.u_m, run.force_n)
+        x_rec = np.round((x + rng.normal(0.0, DRIVE_NOISE_M, x.size)) / 1e-7) * 1e-7
+        frame = pd.DataFrame(
+            {"x_mm": x_rec * 1e3, "u_mm": u_rec * 1e3, "F_N": f_rec},
+            index=pd.Index(t, name="t_s"),
+        )
+        trace = make_trace(name, frame, mass_kg)
+        traces.append(trace)
+        # The trace's u counts from its rest value; the model's rest is u = 0 (plus any
+        # dial gauge offset, which the rest value removes).
+        u_true = run.u_m - run.u_m[0]
+        oracle.append(Outputs(u_true, run.force_n))
+    return traces, oracle, params
+
+
+def run_check(
+    stand: StandConfig,
+    seed: int = 0,
+    trials: int = 1,
+    classes: Sequence[str] = CLASSES,
+    masses: Sequence[float] = MASSES_KG,
+    campaign: Sequence[tuple[str, SignalSpec]] = FULL_CAMPAIGN,
+    progress: Callable[[str], None] | None = None,
+) -> CheckResult:
+    """Diagnose trials × classes × masses blind campaigns and score them."""
+    say = progress or (lambda _m: None)
+    rng = np.random.default_rng(seed)
+    result = CheckResult()
+    total = trials * len(classes) * len(masses)
+    k = 0
+    for _ in range(trials):
+        for mass in masses:
+            for truth in classes:
+                k += 1
+                traces, oracle, params = make_campaign(stand, truth, mass, rng, campaign)
+                started = time.perf_counter()
+                d = diagnose(traces, stand.stand_params("final", mass))
+                seconds = time.perf_counter() - started
+                e_before = d.heldout_error_before
+                shrink = (e_before - d.heldout_error_after) / e_before if e_before > 0 else 0.0
+                e_true = heldout_error(traces, oracle)
+                oracle_shrink = (e_before - e_true) / e_before if e_before > 0 else 0.0
+                result.cases.append(
+                    Case(truth, mass, d.effect, params, shrink, oracle_shrink, seconds)
+                )
+                mark = "ok" if d.effect == truth else "WRONG"
+                say(f"[{k}/{total}] m={mass:g} kg truth {truth}: answer {d.effect} ({mark}, "
+                    f"{seconds:.0f} s)")
+    return result

@@ -1,0 +1,280 @@
+"""The diagnosis: fit the baseline, say where the gap lies, which effect explains it, and
+how far it shrinks on held-out data.
+
+1. Fit the baseline's stiffness, damping and friction scale (``fitting``).
+2. Attribute its residual (``where``).
+3. Screen every candidate effect with a score test: its output change at probe
+   magnitudes, projected off the baseline parameters' directions, and how much of the
+   residual that direction explains (a few simulations per effect).
+4. Refit the best few candidates fully (baseline parameters and the effect's together,
+   multi-start) on the training cycles.
+5. Judge each on the held-out cycles: its error against the fitted baseline's and the
+   noise floor. An effect is chosen only if it closes a clear part of the gap, beats the
+   baseline on held-out cycles with bootstrap confidence, and beats the runner-up; else
+   the answer is ``none``.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from recordings.diagnosis.fitting import Candidate, FitResult, fit, simulate_values
+from recordings.diagnosis.heldout import (
+    Outputs,
+    bootstrap_confidence,
+    channel_gap,
+    cycle_improvements,
+    heldout_error,
+    noise_floor,
+)
+from recordings.diagnosis.traces import Trace
+from recordings.diagnosis.where import SimStates, where_the_gap_lies
+from sim.effects import EFFECTS
+from sim.model import simulate
+from sim.params import StandParams
+
+FloatArray = NDArray[np.float64]
+log = logging.getLogger(__name__)
+
+#: An effect must remove at least this share of the baseline's held-out error…
+MIN_RELATIVE_GAIN = 0.05
+#: …and this share of the part of it above the noise floor…
+MIN_GAP_CLOSURE = 0.3
+#: …with this bootstrap confidence over held-out cycles.
+MIN_CONFIDENCE = 0.95
+#: Refit every candidate whose screening score reaches this share of the best one's.
+REFIT_SHARE = 0.3
+#: Held-out error penalty per extra fitted parameter (relative), to prefer simple effects.
+PARAM_PENALTY = 0.003
+
+Progress = Callable[[str], None]
+
+
+@dataclass
+class Diagnosis:
+    """The answer (see to_dict for the JSON)."""
+
+    effect: str
+    ranking: list[dict[str, Any]]
+    where: dict[str, Any]
+    gap_before: dict[str, dict[str, float]]
+    gap_after: dict[str, dict[str, float]]
+    baseline: dict[str, float]
+    heldout_error_before: float
+    heldout_error_after: float
+    noise_floor: float
+    gap_closure: float
+    confidence: float
+    timings_s: dict[str, float] = field(default_factory=dict)
+    simulations: int = 0
+    outputs_before: list[Outputs] = field(default_factory=list, repr=False)
+    outputs_after: list[Outputs] = field(default_factory=list, repr=False)
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON keys: effect, ranking, where, gap_before, gap_after, and details."""
+        return {
+            "effect": self.effect,
+            "ranking": self.ranking,
+            "where": self.where,
+            "gap_before": self.gap_before,
+            "gap_after": self.gap_after,
+            "baseline_fit": self.baseline,
+            "heldout_error_before": self.heldout_error_before,
+            "heldout_error_after": self.heldout_error_after,
+            "noise_floor": self.noise_floor,
+            "gap_closure": self.gap_closure,
+            "confidence": self.confidence,
+            "simulations": self.simulations,
+            "timings_s": self.timings_s,
+        }
+
+
+def _outputs(candidate: Candidate, values: dict[str, float], traces: Sequence[Trace],
+             nominal: StandParams) -> list[Outputs]:
+    outs = []
+    for tr in traces:
+        u, f = simulate_values(candidate, [values], tr, nominal)
+        outs.append(Outputs(u[0], f[0]))
+    return outs
+
+
+def _probe_values(effect: str, baseline: dict[str, float]) -> list[dict[str, float]]:
+    """A few magnitudes across the plausible range (both signs where the range has both)."""
+    info = EFFECTS[effect]
+    probes = []
+    for frac in (0.2, 0.5, 1.0):
+        values = dict(baseline)
+        for p in info.params:
+            if not p.fit:
+                continue
+            if p.low < 0 < p.high:  # signed: probe both ends
+                v = p.high * frac
+            elif p.log:
+                v = float(np.exp(np.log(p.low) + frac * (np.log(p.high) - np.log(p.low))))
+            else:
+                v = p.low + frac * (p.high - p.low)
+            values[f"{effect}.{p.name}"] = v
+        probes.append(values)
+        signed = [p for p in info.params if p.fit and p.low < 0 < p.high]
+        if signed:
+            neg = dict(values)
+            for p in signed:
+                neg[f"{effect}.{p.name}"] = p.low * frac
+            probes.append(neg)
+    return probes
+
+
+def _stack(traces: Sequence[Trace], outs: Sequence[Outputs]) -> FloatArray:
+    """Normalised training-sample vector of outputs (u and F per trace)."""
+    parts = []
+    for tr, o in zip(traces, outs, strict=True):
+        idx = np.flatnonzero(tr.present & tr.train)[::4]
+        for rec, sim in ((tr.u_m, o.u_m), (tr.force_n, o.force_n)):
+            spread = float(np.linalg.norm(rec[idx] - rec[idx].mean())) or 1.0
+            parts.append(sim[idx] / spread)
+    return np.concatenate(parts)
+
+
+def screen(traces: Sequence[Trace], nominal: StandParams, base_fit: FitResult,
+           base_out: Sequence[Outputs]) -> tuple[dict[str, float], dict[str, dict[str, float]], int]:
+    """Score test: share of the baseline residual each effect's direction explains."""
+    y_rec = _stack(traces, [Outputs(t.u_m, t.force_n) for t in traces])
+    y_base = _stack(traces, base_out)
+    r = y_rec - y_base
+    # Baseline parameters' directions (forward differences), to project off.
+    base_cand = base_fit.candidate
+    cols = []
+    for p in base_cand.params:
+        bumped = dict(base_fit.values)
+        bumped[p.name] = base_fit.values[p.name] * 1.01 if base_fit.values[p.name] else 0.01
+        cols.append(_stack(traces, _outputs(base_cand, bumped, traces, nominal)) - y_base)
+    jb = np.stack(cols, axis=1)
+    q, _ = np.linalg.qr(jb)
+    r_perp = r - q @ (q.T @ r)
+    r2 = float(r_perp @ r_perp) or 1e-300
+    scores: dict[str, float] = {}
+    best_probe: dict[str, dict[str, float]] = {}
+    sims = len(cols)
+    for effect in EFFECTS:
+        cand = Candidate.build(effect)
+        best = 0.0
+        for values in _probe_values(effect, base_fit.values):
+            d = _stack(traces, _outputs(cand, values, traces, nominal)) - y_base
+            sims += 1
+            d_perp = d - q @ (q.T @ d)
+            denom = float(d_perp @ d_perp)
+            a = float(d_perp @ r_perp) / denom if denom > 0 else 0.0
+            # Only a positive multiple of the probe's change is the effect itself;
+            # a multiple far beyond the probe is not a small-effect explanation.
+            explained = (a * a * denom / r2) if 0 < a <= 3.0 else 0.0
+            if explained > best:
+                best = explained
+                best_probe[effect] = values
+        scores[effect] = best
+    return scores, best_probe, sims
+
+
+def diagnose(
+    traces: Sequence[Trace],
+    nominal: StandParams,
+    refit_top: int = 3,
+    progress: Progress | None = None,
+) -> Diagnosis:
+    """Diagnose a campaign of traces of one stand against the nominal parameters."""
+    say = progress or (lambda _msg: None)
+    timings: dict[str, float] = {}
+    t0 = time.perf_counter()
+    say("fitting the baseline (stiffness, damping, friction scale)")
+    base_fit = fit(Candidate.build(None), traces, nominal)
+    base_out = _outputs(base_fit.candidate, base_fit.values, traces, nominal)
+    timings["baseline_fit"] = time.perf_counter() - t0
+    sims = base_fit.evaluations
+
+    states = []
+    for tr in traces:
+        stand, _ = base_fit.candidate.stand_and_effects(nominal, base_fit.values, tr.mass_kg)
+        run = simulate(tr.x_m, tr.rate_hz, stand)
+        states.append(SimStates(run.u_m, run.force_n, run.v_m_s))
+    where = where_the_gap_lies(traces, states)
+
+    t1 = time.perf_counter()
+    say("screening the candidate effects")
+    scores, probes, screen_sims = screen(traces, nominal, base_fit, base_out)
+    sims += screen_sims
+    timings["screening"] = time.perf_counter() - t1
+
+    e_base = heldout_error(traces, base_out)
+    e_noise = noise_floor(traces)
+    order = sorted(scores, key=lambda e: -scores[e])
+    refits: dict[str, tuple[FitResult, list[Outputs], float]] = {}
+    t2 = time.perf_counter()
+    # Refit the leader and whoever the screening cannot tell from it.
+    contenders = [e for e in order[:refit_top] if scores[e] >= REFIT_SHARE * scores[order[0]]]
+    for effect in contenders:
+        say(f"refitting {effect} (screening score {scores[effect]:.3f})")
+        start = dict(probes.get(effect, base_fit.values))
+        res = fit(Candidate.build(effect), traces, nominal, baseline=start, single_start=True)
+        sims += res.evaluations
+        outs = _outputs(res.candidate, res.values, traces, nominal)
+        refits[effect] = (res, outs, heldout_error(traces, outs))
+    timings["refits"] = time.perf_counter() - t2
+
+    ranking = []
+    for effect in order:
+        if effect in refits:
+            res, _, e_aug = refits[effect]
+            penalised = e_aug * (1 + PARAM_PENALTY * (len(res.candidate.params) - 3))
+            closure = (e_base - penalised) / max(e_base - e_noise, 1e-12)
+            ranking.append({"effect": effect, "score": closure, "heldout_error": e_aug,
+                            "screening": scores[effect], "params": _effect_params(effect, res.values)})
+        else:
+            ranking.append({"effect": effect, "score": None, "heldout_error": None,
+                            "screening": scores[effect], "params": {}})
+    ranking.sort(key=lambda r: (r["score"] is None, -(r["score"] or 0.0), -r["screening"]))
+
+    chosen = "none"
+    confidence = 0.0
+    after_out = base_out
+    best = ranking[0]
+    if best["score"] is not None:
+        _, outs, e_aug = refits[best["effect"]]
+        gains = cycle_improvements(traces, base_out, outs)
+        confidence = bootstrap_confidence(gains)
+        relative = (e_base - e_aug) / e_base if e_base > 0 else 0.0
+        log.info("best %s: closure %.3f, relative %.3f, confidence %.3f",
+                 best["effect"], best["score"], relative, confidence)
+        if (best["score"] >= MIN_GAP_CLOSURE and relative >= MIN_RELATIVE_GAIN
+                and confidence >= MIN_CONFIDENCE):
+            chosen = best["effect"]
+            after_out = outs
+    e_after = heldout_error(traces, after_out)
+    timings["total"] = time.perf_counter() - t0
+    return Diagnosis(
+        effect=chosen,
+        ranking=ranking,
+        where=where,
+        gap_before=channel_gap(traces, base_out),
+        gap_after=channel_gap(traces, after_out),
+        baseline=base_fit.values,
+        heldout_error_before=e_base,
+        heldout_error_after=e_after,
+        noise_floor=e_noise,
+        gap_closure=(e_base - e_after) / max(e_base - e_noise, 1e-12),
+        confidence=confidence,
+        timings_s=timings,
+        simulations=sims,
+        outputs_before=base_out,
+        outputs_after=after_out,
+    )
+
+
+def _effect_params(effect: str, values: dict[str, float]) -> dict[str, float]:
+    prefix = f"{effect}."
+    return {k[len(prefix):]: v for k, v in values.items() if k.startswith(prefix)}

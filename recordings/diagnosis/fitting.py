@@ -1,0 +1,264 @@
+"""Bounded, reproducible least-squares fits of the model (with or without an effect).
+
+A *candidate* is the baseline model plus at most one effect. Its free parameters are the
+baseline's uncertain ones — fibre stiffness, fibre damping and the friction table's scale,
+as multipliers of the nominal stand (log scale for the first two) — and the effect's
+fitted parameters within their plausible ranges (sim.effects.registry). Why these three:
+the paper tuned exactly them; mass, geometry and g are measured, not uncertain.
+
+The objective is output error: per trace and channel (u, F), the sum of squared
+residuals normalised by the recorded channel's spread, i.e. the sum of NRMSE², on the
+training samples (every ``stride``-th). Jacobians are forward differences computed as one
+parallel batch of simulations. Output-error landscapes are rugged across slack and snatch
+events, so every fit starts from several points and keeps the best; starts are fixed, so
+fits are reproducible.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.optimize import least_squares
+
+from recordings.diagnosis.traces import Trace
+from sim.effects import EFFECTS, EffectSpec
+from sim.effects.measure import measure_batch_into, measurement_rows
+from sim.effects.simulator import augmented_row, simulate_augmented_rows
+from sim.model import param_vector, simulate_rows
+from sim.params import StandParams
+
+FloatArray = NDArray[np.float64]
+log = logging.getLogger(__name__)
+
+#: Baseline multipliers: (name, low, high, log scale).
+BASELINE_PARAMS = (
+    ("stiffness_scale", 0.5, 2.0, True),
+    ("damping_scale", 0.25, 4.0, True),
+    ("friction_scale", 0.0, 3.0, False),
+)
+
+
+@dataclass(frozen=True)
+class FreeParam:
+    """One fitted parameter: its bounds in natural units and whether it is fitted in log."""
+
+    name: str  # "stiffness_scale", or "<effect>.<param>"
+    low: float
+    high: float
+    log: bool
+
+    def to_internal(self, value: float) -> float:
+        """Natural value → optimiser coordinate."""
+        return float(np.log(value)) if self.log else value
+
+    def bounds(self) -> tuple[float, float]:
+        """Optimiser bounds."""
+        return (self.to_internal(self.low), self.to_internal(self.high))
+
+    def to_natural(self, z: float) -> float:
+        """Optimiser coordinate → natural value."""
+        return float(np.exp(z)) if self.log else z
+
+
+@dataclass
+class Candidate:
+    """The baseline plus at most one effect, with its free parameters."""
+
+    effect: str | None
+    params: list[FreeParam] = field(default_factory=list)
+
+    @classmethod
+    def build(cls, effect: str | None) -> Candidate:
+        """Free parameters for a candidate: the baseline's and the effect's fitted ones."""
+        params = [FreeParam(n, lo, hi, lg) for n, lo, hi, lg in BASELINE_PARAMS]
+        if effect is not None:
+            for p in EFFECTS[effect].params:
+                if p.fit:
+                    low = max(p.minimum, min(p.low, 0.0)) if not p.log else p.low
+                    params.append(FreeParam(f"{effect}.{p.name}", low, p.high, p.log and p.low > 0))
+        return cls(effect, params)
+
+    @property
+    def name(self) -> str:
+        """The effect's name, or 'none' for the baseline."""
+        return self.effect or "none"
+
+    def natural(self, z: FloatArray) -> dict[str, float]:
+        """Optimiser vector → named natural values."""
+        return {p.name: p.to_natural(float(v)) for p, v in zip(self.params, z, strict=True)}
+
+    def stand_and_effects(
+        self, nominal: StandParams, values: dict[str, float], mass_kg: float
+    ) -> tuple[StandParams, list[EffectSpec]]:
+        """The stand and effect a set of values describes."""
+        stand = nominal.with_(
+            mass_kg=mass_kg,
+            stiffness_n_m=nominal.stiffness_n_m * values["stiffness_scale"],
+            damping_n_s_m=nominal.damping_n_s_m * values["damping_scale"],
+            friction_scale=nominal.friction_scale * values["friction_scale"],
+        )
+        effects = []
+        if self.effect is not None:
+            prefix = f"{self.effect}."
+            own = {k[len(prefix) :]: v for k, v in values.items() if k.startswith(prefix)}
+            effects.append(EffectSpec(self.effect, own))
+        return stand, effects
+
+    def start_points(self, baseline: dict[str, float] | None) -> list[FloatArray]:
+        """Deterministic starts: from the baseline fit (or nominal), effect low/mid/default."""
+        base = baseline or {"stiffness_scale": 1.0, "damping_scale": 1.0, "friction_scale": 1.0}
+        starts = []
+        fractions = (0.5,) if self.effect is None else (0.15, 0.5, 0.85)
+        for frac in fractions:
+            z = []
+            for p in self.params:
+                if p.name in base:
+                    z.append(p.to_internal(float(np.clip(base[p.name], p.low, p.high))))
+                else:
+                    lo, hi = p.bounds()
+                    z.append(lo + frac * (hi - lo))
+            starts.append(np.array(z))
+        if self.effect is None and baseline is None:
+            for k in (0.7, 1.4):
+                z = starts[0].copy()
+                z[0] = np.log(k)
+                starts.append(z)
+        return starts
+
+
+@dataclass(frozen=True)
+class FitResult:
+    """A fitted candidate and its errors."""
+
+    candidate: Candidate
+    values: dict[str, float]
+    train_cost: float
+    evaluations: int
+
+
+def simulate_values(
+    candidate: Candidate, values: Sequence[dict[str, float]], trace: Trace, nominal: StandParams
+) -> tuple[FloatArray, FloatArray]:
+    """Recorded-channel outputs u (m), F (N) of a candidate for many value sets, in parallel.
+
+    The baseline and measurement effects run on the fast baseline kernel (a measurement
+    effect only transforms its outputs); physical effects on the augmented kernel (which
+    reproduces the baseline to 1e-9 with every effect off).
+    """
+    x_rel = trace.x_m - trace.x_m[0]
+    stands = [candidate.stand_and_effects(nominal, v, trace.mass_kg) for v in values]
+    physical = candidate.effect is not None and EFFECTS[candidate.effect].kind == "physical"
+    if not physical:
+        # Baseline dynamics on the fast kernel; a measurement effect only transforms them.
+        rows = np.stack([param_vector(stand) for stand, _ in stands])
+        base = simulate_rows(x_rel, trace.rate_hz, rows, nominal.friction)
+        if candidate.effect is None:
+            return base.u_m, base.force_n
+        mrows = measurement_rows(np.stack([augmented_row(s, e) for s, e in stands]))
+        out_u, out_f = np.empty_like(base.u_m), np.empty_like(base.force_n)
+        measure_batch_into(base.u_m, base.force_n, 1.0 / trace.rate_hz, mrows, out_u, out_f)
+        return out_u, out_f
+    rows = np.stack([augmented_row(stand, effects) for stand, effects in stands])
+    res = simulate_augmented_rows(x_rel, trace.rate_hz, rows, nominal.friction)
+    return res.u_m, res.force_n
+
+
+class Objective:
+    """Residuals of a candidate over traces; simulations batched across parameter sets."""
+
+    def __init__(
+        self, candidate: Candidate, traces: Sequence[Trace], nominal: StandParams, stride: int = 4
+    ) -> None:
+        self.candidate = candidate
+        self.traces = list(traces)
+        self.nominal = nominal
+        self.stride = stride
+        self.simulations = 0
+        self._cache: dict[bytes, FloatArray] = {}
+        self._masks = []
+        for tr in self.traces:
+            idx = np.flatnonzero(tr.present & tr.train)[::stride]
+            su = float(np.linalg.norm(tr.u_m[idx] - tr.u_m[idx].mean())) or 1.0
+            sf = float(np.linalg.norm(tr.force_n[idx] - tr.force_n[idx].mean())) or 1.0
+            self._masks.append((idx, su, sf))
+
+    def outputs(self, zs: FloatArray, trace: Trace) -> tuple[FloatArray, FloatArray]:
+        """Simulated recorded u (m) and F (N) for parameter vectors zs (sets, params)."""
+        self.simulations += len(zs)
+        return simulate_values(
+            self.candidate, [self.candidate.natural(z) for z in zs], trace, self.nominal
+        )
+
+    def residuals_batch(self, zs: FloatArray) -> FloatArray:
+        """Residual vectors for many parameter vectors at once, shape (sets, residuals)."""
+        parts = []
+        for tr, (idx, su, sf) in zip(self.traces, self._masks, strict=True):
+            u, f = self.outputs(zs, tr)
+            parts.append((u[:, idx] - tr.u_m[idx]) / su)
+            parts.append((f[:, idx] - tr.force_n[idx]) / sf)
+        out = np.concatenate(parts, axis=1)
+        return np.where(np.isfinite(out), out, 1e3)  # a diverged run is simply very bad
+
+    def residuals(self, z: FloatArray) -> FloatArray:
+        """One residual vector (memoised: least_squares asks for it twice)."""
+        key = np.asarray(z, dtype=np.float64).tobytes()
+        if key not in self._cache:
+            self._cache = {key: self.residuals_batch(np.atleast_2d(z))[0]}
+        return self._cache[key]
+
+    def jacobian(self, z: FloatArray) -> FloatArray:
+        """Forward differences, all columns in one batch (plus the base point)."""
+        lo = np.array([p.bounds()[0] for p in self.candidate.params])
+        hi = np.array([p.bounds()[1] for p in self.candidate.params])
+        step = 1e-3 * (hi - lo)
+        zs = [z]
+        signs = []
+        for i in range(z.size):
+            zi = z.copy()
+            sign = 1.0 if z[i] + step[i] <= hi[i] else -1.0
+            zi[i] += sign * step[i]
+            zs.append(zi)
+            signs.append(sign)
+        r = self.residuals_batch(np.stack(zs))
+        self._cache = {np.asarray(z, dtype=np.float64).tobytes(): r[0]}
+        cols = [(r[i + 1] - r[0]) / (signs[i] * step[i]) for i in range(z.size)]
+        return np.stack(cols, axis=1)
+
+
+def fit(
+    candidate: Candidate,
+    traces: Sequence[Trace],
+    nominal: StandParams,
+    baseline: dict[str, float] | None = None,
+    stride: int = 4,
+    max_nfev: int = 40,
+    single_start: bool = False,
+) -> FitResult:
+    """Fit a candidate's free parameters on the traces' training samples (multi-start).
+
+    ``single_start`` starts only from ``baseline`` (which then also holds the effect's
+    values, e.g. the screening's best probe).
+    """
+    objective = Objective(candidate, traces, nominal, stride)
+    lo = np.array([p.bounds()[0] for p in candidate.params])
+    hi = np.array([p.bounds()[1] for p in candidate.params])
+    best: tuple[float, FloatArray] | None = None
+    starts = candidate.start_points(baseline)
+    if single_start and baseline is not None:
+        starts = [np.array([p.to_internal(float(np.clip(baseline.get(p.name, 0.5 * (p.low + p.high)), p.low, p.high))) for p in candidate.params])]
+    for z0 in starts:
+        z0 = np.clip(z0, lo + 1e-9 * (hi - lo), hi - 1e-9 * (hi - lo))
+        sol = least_squares(
+            objective.residuals, z0, jac=objective.jacobian, bounds=(lo, hi),
+            method="trf", x_scale="jac", max_nfev=max_nfev, xtol=1e-6, ftol=1e-8,
+        )  # fmt: skip
+        cost = float(np.sum(sol.fun**2))
+        log.debug("%s start %s -> cost %.6g (%d evals)", candidate.name, z0, cost, sol.nfev)
+        if best is None or cost < best[0]:
+            best = (cost, sol.x)
+    assert best is not None
+    return FitResult(candidate, candidate.natural(best[1]), best[0], objective.simulations)

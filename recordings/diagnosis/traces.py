@@ -1,0 +1,145 @@
+"""Recordings prepared for diagnosis: uniform grid, phases, cycles, held-out split.
+
+A *trace* is one recording on its own uniform time grid with everything the fit and the
+attribution need: the drive position that excites the model, the recorded u (from its
+rest value) and F, which samples exist, the phase of the drive motion at every sample,
+which cycle each sample belongs to, and whether it is used for fitting or held out.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+from numpy.typing import NDArray
+
+from recordings.replay import ReplayError, align
+
+FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.int64]
+BoolArray = NDArray[np.bool_]
+
+PHASES = ("rise", "hold", "fall", "rest")
+PHASE_RISE, PHASE_HOLD, PHASE_FALL, PHASE_REST = range(4)
+#: The drive counts as moving above this speed, m/s.
+MOVING_SPEED_M_S = 1e-3
+#: A recording shorter than this cannot identify anything, s.
+MIN_DURATION_S = 1.0
+#: Less drive travel than this identifies nothing, m.
+MIN_STROKE_M = 1e-3
+
+
+class DiagnosisInputError(ValueError):
+    """Recordings that cannot be diagnosed; the message says what is missing."""
+
+
+@dataclass(frozen=True)
+class Trace:
+    """One recording ready for fitting (SI units, uniform grid at ``rate_hz``)."""
+
+    name: str
+    rate_hz: float
+    mass_kg: float
+    x_m: FloatArray
+    u_m: FloatArray  # from the rest value; NaN where lost
+    force_n: FloatArray  # absolute; NaN where lost
+    present: BoolArray
+    phase: IntArray
+    cycle: IntArray  # -1 before the first cycle
+    train: BoolArray  # used for fitting (the rest is held out)
+    noise_u_m: float  # rms of u during the initial rest (sensor noise floor)
+    noise_force_n: float
+    stroke_m: float
+
+    @property
+    def samples(self) -> int:
+        """Grid length."""
+        return int(self.x_m.size)
+
+    @property
+    def test(self) -> BoolArray:
+        """Held-out samples that exist."""
+        return self.present & ~self.train
+
+    @property
+    def duration_s(self) -> float:
+        """Length of the grid, s."""
+        return self.samples / self.rate_hz
+
+
+def drive_phases(x_m: FloatArray, rate_hz: float) -> IntArray:
+    """Phase of the drive at every sample: rise (x increasing: pulling), hold, fall, rest."""
+    v = np.gradient(x_m, 1.0 / rate_hz)
+    top = x_m.max()
+    low = x_m.min()
+    high_level = x_m > low + 0.5 * (top - low)
+    phase = np.where(high_level, PHASE_HOLD, PHASE_REST).astype(np.int64)
+    phase[v > MOVING_SPEED_M_S] = PHASE_RISE
+    phase[v < -MOVING_SPEED_M_S] = PHASE_FALL
+    return phase
+
+
+def cycle_index(phase: IntArray) -> IntArray:
+    """Cycle number at every sample: a cycle starts where a rise starts after rest."""
+    rising = phase == PHASE_RISE
+    starts = np.flatnonzero(rising[1:] & ~rising[:-1]) + 1
+    if rising[0]:
+        starts = np.concatenate([[0], starts])
+    # Merge starts closer than a few samples (jitter at ramp ends) into one.
+    cycle = np.full(phase.size, -1, dtype=np.int64)
+    for k, s in enumerate(starts):
+        cycle[s:] = k
+    return cycle
+
+
+def _split(cycle: IntArray, n: int) -> BoolArray:
+    """Interleave: even cycles (and the lead-in) train, odd cycles held out."""
+    cycles = int(cycle.max()) + 1
+    if cycles >= 2:
+        train = (cycle < 0) | (cycle % 2 == 0)
+        return np.asarray(train, dtype=bool)
+    # One cycle or none: first half trains, second half is held out.
+    train = np.zeros(n, dtype=bool)
+    train[: n // 2] = True
+    return train
+
+
+def make_trace(name: str, frame: pd.DataFrame, mass_kg: float) -> Trace:
+    """Prepare one recording (its DataFrame: t_s index, x_mm, u_mm, F_N)."""
+    try:
+        run = align(frame)
+    except ReplayError as err:
+        raise DiagnosisInputError(f"{name}: {err}") from None
+    if run.t_s[-1] < MIN_DURATION_S:
+        raise DiagnosisInputError(
+            f"{name}: {run.t_s[-1]:.2f} s is too short to fit (need ≥ {MIN_DURATION_S:g} s)"
+        )
+    stroke = float(np.ptp(run.x_m))
+    if stroke < MIN_STROKE_M:
+        raise DiagnosisInputError(
+            f"{name}: the drive moves only {stroke * 1e3:.3f} mm: a flat drive signal excites "
+            "nothing to identify"
+        )
+    rest = run.rest_samples
+    u_rest = np.nanmean(run.u_m[:rest]) if rest > 1 else run.u_m[np.isfinite(run.u_m)][0]
+    u = run.u_m - u_rest
+    noise_u = float(np.nanstd(run.u_m[:rest])) if rest > 10 else 0.0
+    noise_f = float(np.nanstd(run.force_n[:rest])) if rest > 10 else 0.0
+    phase = drive_phases(run.x_m, run.rate_hz)
+    cycle = cycle_index(phase)
+    return Trace(
+        name=name,
+        rate_hz=run.rate_hz,
+        mass_kg=mass_kg,
+        x_m=run.x_m,
+        u_m=u,
+        force_n=run.force_n,
+        present=run.present & np.isfinite(u) & np.isfinite(run.force_n),
+        phase=phase,
+        cycle=cycle,
+        train=_split(cycle, run.x_m.size),
+        noise_u_m=noise_u,
+        noise_force_n=noise_f,
+        stroke_m=stroke,
+    )
