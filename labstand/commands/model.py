@@ -1,4 +1,4 @@
-"""``labstand model``: properties of the model itself (linearised modes)."""
+"""``labstand model``: properties of the model itself (linearised modes, the effects)."""
 
 from __future__ import annotations
 
@@ -7,6 +7,7 @@ import json
 from typing import Any
 
 from labstand.commands.common import add_stand_options, load_stand
+from sim.effects import EFFECTS
 from sim.modes import linear_modes
 
 
@@ -24,6 +25,15 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     modes.add_argument("--mass-kg", type=float, help="weight mass, kg (default: every weight)")
     modes.add_argument("--json", action="store_true", help="print JSON (key modes_hz)")
     modes.set_defaults(func=run_modes)
+    effects = model_sub.add_parser(
+        "effects",
+        help="the unmodelled effects and their parameters",
+        description="The effects `labstand simulate --effect NAME[:param=value,...]` can "
+        "switch on (STAND.md §5): each parameter's unit, default, plausible range (low–high) "
+        "and admissible range (min–max). Equations: docs/effects.md.",
+    )
+    effects.add_argument("--json", action="store_true", help="print JSON (key effects)")
+    effects.set_defaults(func=run_effects)
 
 
 def run_modes(args: argparse.Namespace) -> int:
@@ -57,4 +67,20 @@ def run_modes(args: argparse.Namespace) -> int:
             f"  m = {r['mass_kg']:.3f} kg  {r['mode']}: {r['frequency_hz']:.2f} Hz, "
             f"damping ratio {r['damping_ratio']:.3f}"
         )
+    return 0
+
+
+def run_effects(args: argparse.Namespace) -> int:
+    """List every effect with its parameters."""
+    if args.json:
+        print(json.dumps({"effects": [info.to_dict() for info in EFFECTS.values()]}, indent=2))
+        return 0
+    for info in EFFECTS.values():
+        print(f"{info.name} ({info.kind}): {info.summary}")
+        print(f"  shows: {info.shows}")
+        for p in info.params:
+            print(
+                f"  {p.name:<22} default {p.default:<9g} plausible {p.low:g} … {p.high:g}, "
+                f"admissible {p.minimum:g} … {p.maximum:g} [{p.unit}]"
+            )
     return 0

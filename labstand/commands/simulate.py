@@ -5,17 +5,22 @@ from __future__ import annotations
 import argparse
 import json
 import time
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from drivers.signals import DriveProfile, Shape, SignalSpec, plan_motion
 from labstand.commands.common import add_stand_options, load_stand
 from labstand.errors import CommandError, ExitCode
 from labstand.output import write_simulation
 from sim.config import StandConfig
+from sim.effects import EffectSpec, parse_effects, simulate_augmented
+from sim.effects.realism import NoiseSpec, add_measurement_noise
 from sim.model import SimResult, simulate
+from sim.params import StandParams
 from sim.situations import SITUATIONS, situation
 
 
@@ -81,6 +86,17 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     parser.add_argument("-o", "--output", type=Path, help="write the run here (.csv, ...)")
     parser.add_argument("--plot", type=Path, metavar="PNG", help="plot x, u and F to a PNG")
     parser.add_argument("--json", action="store_true", help="print a JSON summary")
+    effects = parser.add_argument_group("unmodelled effects (docs/effects.md)")
+    effects.add_argument(
+        "--effect",
+        action="append",
+        metavar="NAME[:param=value,...]",
+        help="switch an effect on (repeatable); see `labstand model effects`",
+    )
+    effects.add_argument(
+        "--noise", action="store_true", help="add realistic gauge noise, mains hum, quantisation"
+    )
+    effects.add_argument("--seed", type=int, default=0, help="seed of --noise (default 0)")
     parser.set_defaults(func=run)
 
 
@@ -109,10 +125,17 @@ def run(args: argparse.Namespace) -> int:
     profile = plan_motion(spec, config.drive)
     params = config.stand_params(args.params, mass)
     _, x_m = profile.sample(config.sample_rate_hz)
+    effects = parse_effects(args.effect or [])
     started = time.perf_counter()
-    result = simulate(x_m, config.sample_rate_hz, params)
+    if effects or args.noise:
+        result, truth = _simulate_real_like(x_m, config.sample_rate_hz, params, effects, args)
+    else:
+        result = truth = simulate(x_m, config.sample_rate_hz, params)
     elapsed = time.perf_counter() - started
-    summary = summarise(result, profile, mass)
+    summary = summarise(truth, profile, mass)
+    if effects or args.noise:
+        summary["effects"] = [str(e) for e in effects]
+        summary["noise_seed"] = args.seed if args.noise else None
     summary["params"] = args.params
     summary["situation"] = args.situation
     summary["wall_s"] = elapsed
@@ -129,6 +152,25 @@ def run(args: argparse.Namespace) -> int:
     else:
         _print_summary(summary)
     return 0
+
+
+def _simulate_real_like(
+    x_m: NDArray[np.float64],
+    rate_hz: float,
+    params: StandParams,
+    effects: list[EffectSpec],
+    args: argparse.Namespace,
+) -> tuple[SimResult, SimResult]:
+    """The augmented model with --effect, then --noise (seeded by --seed).
+
+    Returns the recorded-like run and the true one (for the summary's slack figures).
+    """
+    run = simulate_augmented(x_m, rate_hz, params, effects)
+    truth = replace(run, u_m=run.true_u_m, force_n=run.true_force_n)
+    result: SimResult = run
+    if args.noise:
+        result = add_measurement_noise(run, np.random.default_rng(args.seed), NoiseSpec())
+    return result, truth
 
 
 def _title(args: argparse.Namespace, spec: SignalSpec, mass: float) -> str:

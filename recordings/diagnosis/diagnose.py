@@ -47,6 +47,9 @@ log = logging.getLogger(__name__)
 MIN_RELATIVE_GAIN = 0.05
 #: …and this share of the part of it above the noise floor…
 MIN_GAP_CLOSURE = 0.3
+#: …by at least this share of the noise floor itself (an improvement smaller than the
+#: noise's own jitter is not evidence)…
+MIN_GAIN_OVER_NOISE = 0.25
 #: …with this bootstrap confidence over held-out cycles.
 MIN_CONFIDENCE = 0.95
 #: Refit every candidate whose screening score reaches this share of the best one's.
@@ -231,7 +234,8 @@ def diagnose(
         if effect in refits:
             res, _, e_aug = refits[effect]
             penalised = e_aug * (1 + PARAM_PENALTY * (len(res.candidate.params) - 3))
-            closure = (e_base - penalised) / max(e_base - e_noise, 1e-12)
+            # Gap closure; clipped below at −1 (far worse than the baseline is just worse).
+            closure = max(-1.0, (e_base - penalised) / max(e_base - e_noise, 1e-12))
             ranking.append({"effect": effect, "score": closure, "heldout_error": e_aug,
                             "screening": scores[effect], "params": _effect_params(effect, res.values)})
         else:
@@ -251,6 +255,7 @@ def diagnose(
         log.info("best %s: closure %.3f, relative %.3f, confidence %.3f",
                  best["effect"], best["score"], relative, confidence)
         if (best["score"] >= MIN_GAP_CLOSURE and relative >= MIN_RELATIVE_GAIN
+                and e_base - e_aug >= MIN_GAIN_OVER_NOISE * e_noise
                 and confidence >= MIN_CONFIDENCE):
             chosen = best["effect"]
             after_out = outs

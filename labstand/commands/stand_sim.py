@@ -1,0 +1,236 @@
+"""``labstand stand-sim``: run the simulated stand on its own, and start it from Python.
+
+The command serves the simulated Unidrive SP (Modbus TCP on 127.0.0.1 or RTU on a pty)
+and the simulated gauge front end (2 kHz frames on a pty), prints where to connect —
+with ``--json`` as one line ``{"event": "ready", "modbus": URL, "gauges": PATH, ...}`` —
+and runs until Ctrl-C or SIGTERM, or until the process named by ``--parent-pid`` is
+gone. On exit it prints ``{"event": "stopped", ...}`` and leaves nothing running.
+
+``StandProcess`` starts the command as a child process (how ``labstand run --backend
+sim`` uses it): it passes its own pid as ``--parent-pid``, so the child exits within a
+fraction of a second even if the parent is killed with SIGKILL.
+"""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+import contextlib
+import json
+import os
+import select
+import signal
+import subprocess
+import sys
+import time
+from collections.abc import Sequence
+from types import TracebackType
+from typing import Any, Self, TextIO
+
+from labstand.commands.common import add_stand_options, load_stand
+from labstand.errors import CommandError
+from sim.hardware.gauges import FrontEndSettings
+from sim.hardware.stand import ScaledClock, SimulatedStand, StandSettings
+
+PARENT_POLL_S = 0.2
+
+
+def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
+    """Add ``labstand stand-sim``."""
+    parser = sub.add_parser(
+        "stand-sim",
+        help="run the simulated stand (Modbus drive + 2 kHz gauges) on its own",
+        description="Serve the simulated Unidrive SP over Modbus (TCP on 127.0.0.1, or RTU on "
+        "a pseudo-terminal) and the simulated gauge front end on a pseudo-terminal, both "
+        "driven by the stand model. Prints where to connect; stops on Ctrl-C or SIGTERM.",
+    )
+    add_stand_options(parser, params=True)
+    parser.add_argument("--mass-kg", type=float, help="weight mass, kg (default: the stand's)")
+    parser.add_argument(
+        "--modbus",
+        default="tcp://127.0.0.1:0",
+        metavar="SPEC",
+        help="tcp://127.0.0.1:PORT (0: any free port; the default), rtu (a pty pair of its "
+        "own) or rtu:PATH (serve on an existing serial port)",
+    )
+    parser.add_argument(
+        "--effect",
+        action="append",
+        default=[],
+        metavar="NAME",
+        help="switch an unmodelled effect on in the simulated stand (repeatable)",
+    )
+    parser.add_argument(
+        "--speed",
+        type=float,
+        default=1.0,
+        help="simulated seconds per wall second (default 1: real time)",
+    )
+    parser.add_argument("--seed", type=int, default=0, help="gauge noise seed (default 0)")
+    parser.add_argument("--json", action="store_true", help="print the endpoints as one JSON line")
+    parser.add_argument(
+        "--parent-pid",
+        type=int,
+        metavar="PID",
+        help="exit when this process is gone (for programs that start the simulated stand)",
+    )
+    parser.set_defaults(func=run_stand_sim)
+
+
+def _say(text: str, stream: TextIO | None = None) -> None:
+    """Print and flush; a reader that went away (a dead parent's pipe) is not an error."""
+    with contextlib.suppress(OSError):
+        print(text, file=stream or sys.stdout, flush=True)
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
+async def _serve(stand: SimulatedStand, args: argparse.Namespace) -> None:
+    endpoints = await stand.start()
+    stop = asyncio.Event()
+    loop = asyncio.get_running_loop()
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        loop.add_signal_handler(sig, stop.set)
+    info = endpoints.to_dict()
+    if args.json:
+        _say(json.dumps({"event": "ready", "pid": os.getpid(), **info}))
+    else:
+        _say(f"simulated stand (pid {os.getpid()}), {info['speed']:g}× real time")
+        _say(f"  drive (Unidrive SP, Modbus): {info['modbus']}")
+        rate, size = info["rate_hz"], info["frame_bytes"]
+        _say(f"  gauges ({rate:g} Hz, {size}-byte frames): {info['gauges']}")
+        _say("stop with Ctrl-C")
+
+    async def watch_parent(pid: int) -> None:
+        first_parent = os.getppid()
+        while not stop.is_set():
+            if not _alive(pid) or os.getppid() != first_parent:
+                stop.set()
+                _say(f"labstand stand-sim: parent {pid} is gone; stopping", sys.stderr)
+            await asyncio.sleep(PARENT_POLL_S)
+
+    watcher = asyncio.create_task(watch_parent(args.parent_pid)) if args.parent_pid else None
+    try:
+        await stand.serve(stop)
+    finally:
+        if watcher is not None:
+            watcher.cancel()
+            with contextlib.suppress(asyncio.CancelledError):
+                await watcher
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            loop.remove_signal_handler(sig)
+        await stand.close()
+
+
+def run_stand_sim(args: argparse.Namespace) -> int:
+    """Serve until stopped."""
+    config = load_stand(args)
+    settings = StandSettings(
+        modbus=args.modbus,
+        effects=tuple(args.effect),
+        frontend=FrontEndSettings(rate_hz=config.sample_rate_hz, seed=args.seed),
+    )
+    stand = SimulatedStand.from_config(
+        config, args.params, args.mass_kg, settings, ScaledClock(args.speed)
+    )
+    try:
+        asyncio.run(_serve(stand, args))
+    finally:
+        summary = stand.summary()
+        if args.json:
+            _say(json.dumps({"event": "stopped", **summary}))
+    return 0
+
+
+class StandProcess:
+    """``labstand stand-sim --json`` as a child process.
+
+    ``with StandProcess(["--mass-kg", "3.096"]) as sim: sim.endpoints["modbus"]`` starts
+    it, waits for its ready line and stops it (SIGTERM, then SIGKILL) on exit.
+    """
+
+    def __init__(self, extra_args: Sequence[str] = (), start_timeout_s: float = 30.0) -> None:
+        self.args = [
+            sys.executable,
+            "-m",
+            "labstand",
+            "stand-sim",
+            "--json",
+            "--parent-pid",
+            str(os.getpid()),
+            *extra_args,
+        ]
+        self._timeout = start_timeout_s
+        self.process: subprocess.Popen[str] | None = None
+        self.endpoints: dict[str, Any] = {}
+        self.stopped: dict[str, Any] = {}  # the child's last line, once it has exited
+
+    def start(self) -> dict[str, Any]:
+        """Start the child and return its ready line (endpoints)."""
+        self.process = subprocess.Popen(
+            self.args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+        )
+        assert self.process.stdout is not None
+        ready, _, _ = select.select([self.process.stdout], [], [], self._timeout)
+        line = self.process.stdout.readline() if ready else ""
+        if not line:
+            self.stop()
+            raise CommandError(f"the simulated stand did not start: {self._stderr()}")
+        self.endpoints = json.loads(line)
+        return self.endpoints
+
+    def _stderr(self) -> str:
+        if self.process is None or self.process.stderr is None or self.process.poll() is None:
+            return "no ready line in time"
+        return self.process.stderr.read().strip()[-2000:]
+
+    def stop(self, timeout_s: float = 5.0) -> int | None:
+        """SIGTERM and wait; SIGKILL if it does not exit in time. Returns the exit code."""
+        p = self.process
+        if p is None:
+            return None
+        if p.poll() is None:
+            p.terminate()
+            try:
+                p.wait(timeout_s)
+            except subprocess.TimeoutExpired:
+                p.kill()
+                p.wait(timeout_s)
+        if p.stdout is not None and not p.stdout.closed:
+            for line in p.stdout.read().splitlines():
+                with contextlib.suppress(ValueError):
+                    self.stopped = json.loads(line)
+        for stream in (p.stdout, p.stderr):
+            if stream is not None:
+                stream.close()
+        return p.returncode
+
+    def __enter__(self) -> Self:
+        self.start()
+        return self
+
+    def __exit__(
+        self,
+        exc_type: type[BaseException] | None,
+        exc: BaseException | None,
+        tb: TracebackType | None,
+    ) -> None:
+        self.stop()
+
+
+def wait_exit(process: subprocess.Popen[Any], timeout_s: float) -> int | None:
+    """The exit code once the process ends within timeout_s, else None."""
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline:
+        if (code := process.poll()) is not None:
+            return code
+        time.sleep(0.02)
+    return None
