@@ -1,21 +1,56 @@
 """Hardware drivers and the drive-signal generators.
 
+An acquisition session depends on two small interfaces (``drivers.interfaces``):
+``DriveInterface`` (implemented by ``UnidriveSP``, Modbus TCP or RTU, built with
+``open_unidrive(url, limits)``) and ``GaugeSource`` (implemented by
+``SerialGaugeStream``, built with ``open_gauges(path, calibration)``). Which port or
+address they use is configuration; the simulated stand serves the same protocols.
+
 Exceptions::
 
-    ValueError
-     └── LimitError      a command beyond the drive's limits (nothing moved)
+    Exception
+     ├── ValueError
+     │    └── LimitError        a command beyond the drive's limits (nothing moved)
+     ├── DriveError             drivers.unidrive (tree in its docstring)
+     └── GaugeError             drivers.gauge_stream (tree in its docstring)
+    RuntimeError
+     └── ClosedError            a driver used after close()
 """
 
 from drivers.calibration import GaugeCalibration
+from drivers.gauge_stream import GaugeError, SerialGaugeStream, open_gauges
+from drivers.interfaces import (
+    SAMPLE_DTYPE,
+    ClosedError,
+    DriveInterface,
+    DriveState,
+    GaugeSource,
+    GaugeStats,
+)
 from drivers.limits import DriveLimits, LimitError
 from drivers.signals import DriveProfile, Shape, SignalSpec, plan_motion
+from drivers.unidrive import DriveError, UnidriveSP, open_unidrive
+from drivers.unidrive_profile import ProfileState
 
 __all__ = [
+    "SAMPLE_DTYPE",
+    "ClosedError",
+    "DriveError",
+    "DriveInterface",
     "DriveLimits",
     "DriveProfile",
+    "DriveState",
     "GaugeCalibration",
+    "GaugeError",
+    "GaugeSource",
+    "GaugeStats",
     "LimitError",
+    "ProfileState",
+    "SerialGaugeStream",
     "Shape",
     "SignalSpec",
+    "UnidriveSP",
+    "open_gauges",
+    "open_unidrive",
     "plan_motion",
 ]

@@ -1,0 +1,49 @@
+"""The simulated stand on real wire protocols (docs/hardware-design.md).
+
+A simulated Unidrive SP (pymodbus server: TCP on 127.0.0.1 or RTU on a pty) and a
+simulated gauge front end (2 kHz binary frames on a raw pty) share one simulated stand:
+the gauges see the position the simulated drive really ran, through the stand model.
+
+From Python::
+
+    from sim.config import default_config
+    from sim.hardware import SimulatedStand, StandThread
+
+    with StandThread(SimulatedStand.from_config(default_config())) as endpoints:
+        drive = open_unidrive(endpoints.modbus, limits)      # drivers.unidrive
+        gauges = open_gauges(endpoints.gauges, calibration)  # drivers.gauge_stream
+
+As a process: ``labstand stand-sim --json`` (see labstand/commands/stand_sim.py).
+"""
+
+from sim.hardware.drive import SimulatedDrive
+from sim.hardware.gauges import FrontEndSettings, GaugeFrontEnd, StandModel
+from sim.hardware.inprocess import InProcessClient
+from sim.hardware.servo import ServoSettings
+from sim.hardware.stand import (
+    Clock,
+    Endpoints,
+    ScaledClock,
+    SimulatedStand,
+    StandSettings,
+    StandThread,
+)
+from sim.hardware.stand_model import available_effects, build_stand_model, register_effect
+
+__all__ = [
+    "Clock",
+    "Endpoints",
+    "FrontEndSettings",
+    "GaugeFrontEnd",
+    "InProcessClient",
+    "ScaledClock",
+    "ServoSettings",
+    "SimulatedDrive",
+    "SimulatedStand",
+    "StandModel",
+    "StandSettings",
+    "StandThread",
+    "available_effects",
+    "build_stand_model",
+    "register_effect",
+]
