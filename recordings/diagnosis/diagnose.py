@@ -49,11 +49,16 @@ MIN_RELATIVE_GAIN = 0.05
 MIN_GAP_CLOSURE = 0.3
 #: …by at least this share of the noise floor itself (an improvement smaller than the
 #: noise's own jitter is not evidence)…
-MIN_GAIN_OVER_NOISE = 0.25
+MIN_GAIN_OVER_NOISE = 0.1
 #: …with this bootstrap confidence over held-out cycles.
 MIN_CONFIDENCE = 0.95
-#: Refit every candidate whose screening score reaches this share of the best one's.
-REFIT_SHARE = 0.3
+#: Refit every candidate whose screening score reaches this share of the best one's (0:
+#: refit all; the screening only orders them and gives their start values). Screening
+#: alone missed effects whose output change is far from linear in their magnitude
+#: (pulley jump, string modes), so every candidate is refitted.
+REFIT_SHARE = 0.0
+#: Optimiser evaluations per candidate refit (each a batch of simulations).
+REFIT_EVALUATIONS = 15
 #: Held-out error penalty per extra fitted parameter (relative), to prefer simple effects.
 PARAM_PENALTY = 0.003
 
@@ -187,7 +192,7 @@ def screen(traces: Sequence[Trace], nominal: StandParams, base_fit: FitResult,
 def diagnose(
     traces: Sequence[Trace],
     nominal: StandParams,
-    refit_top: int = 3,
+    refit_top: int = 9,
     progress: Progress | None = None,
 ) -> Diagnosis:
     """Diagnose a campaign of traces of one stand against the nominal parameters."""
@@ -223,7 +228,10 @@ def diagnose(
     for effect in contenders:
         say(f"refitting {effect} (screening score {scores[effect]:.3f})")
         start = dict(probes.get(effect, base_fit.values))
-        res = fit(Candidate.build(effect), traces, nominal, baseline=start, single_start=True)
+        started = time.perf_counter()
+        res = fit(Candidate.build(effect), traces, nominal, baseline=start, single_start=True,
+                  max_nfev=REFIT_EVALUATIONS)
+        timings[f"refit {effect}"] = time.perf_counter() - started
         sims += res.evaluations
         outs = _outputs(res.candidate, res.values, traces, nominal)
         refits[effect] = (res, outs, heldout_error(traces, outs))

@@ -122,11 +122,6 @@ class Candidate:
                     lo, hi = p.bounds()
                     z.append(lo + frac * (hi - lo))
             starts.append(np.array(z))
-        if self.effect is None and baseline is None:
-            for k in (0.7, 1.4):
-                z = starts[0].copy()
-                z[0] = np.log(k)
-                starts.append(z)
         return starts
 
 
@@ -229,6 +224,28 @@ class Objective:
         return np.stack(cols, axis=1)
 
 
+#: Baseline pre-search grid (multipliers of nominal): slack and snatch timing make the
+#: output error rugged in the stiffness, so a local fit from nominal alone can stall.
+GRID_STIFFNESS = np.geomspace(0.6, 1.6, 9)
+GRID_DAMPING = (0.5, 1.0, 2.0)
+GRID_FRICTION = (0.5, 1.0, 1.5)
+GRID_STARTS = 3
+
+
+def _grid_starts(objective: Objective) -> list[FloatArray]:
+    """The best few points of a coarse grid over the baseline multipliers (one batch)."""
+    grid = np.array(
+        [
+            [np.log(k), np.log(c), f]
+            for k in GRID_STIFFNESS
+            for c in GRID_DAMPING
+            for f in GRID_FRICTION
+        ]
+    )
+    costs = np.sum(objective.residuals_batch(grid) ** 2, axis=1)
+    return [grid[i] for i in np.argsort(costs)[:GRID_STARTS]]
+
+
 def fit(
     candidate: Candidate,
     traces: Sequence[Trace],
@@ -248,6 +265,8 @@ def fit(
     hi = np.array([p.bounds()[1] for p in candidate.params])
     best: tuple[float, FloatArray] | None = None
     starts = candidate.start_points(baseline)
+    if candidate.effect is None and baseline is None:
+        starts = _grid_starts(objective)
     if single_start and baseline is not None:
         starts = [np.array([p.to_internal(float(np.clip(baseline.get(p.name, 0.5 * (p.low + p.high)), p.low, p.high))) for p in candidate.params])]
     for z0 in starts:

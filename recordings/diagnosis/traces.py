@@ -76,27 +76,46 @@ class Trace:
 
 
 def drive_phases(x_m: FloatArray, rate_hz: float) -> IntArray:
-    """Phase of the drive at every sample: rise (x increasing: pulling), hold, fall, rest."""
+    """Phase of the drive at every sample: rise (x increasing: pulling), hold, fall, rest.
+
+    The velocity is smoothed over 20 ms and "moving" means faster than 5 % of the peak
+    speed (at least MOVING_SPEED_M_S), so encoder noise during holds is no motion.
+    """
     v = np.gradient(x_m, 1.0 / rate_hz)
+    width = max(1, int(0.02 * rate_hz))
+    v = np.convolve(v, np.ones(width) / width, mode="same")
+    threshold = max(MOVING_SPEED_M_S, 0.05 * float(np.abs(v).max()))
     top = x_m.max()
     low = x_m.min()
     high_level = x_m > low + 0.5 * (top - low)
     phase = np.where(high_level, PHASE_HOLD, PHASE_REST).astype(np.int64)
-    phase[v > MOVING_SPEED_M_S] = PHASE_RISE
-    phase[v < -MOVING_SPEED_M_S] = PHASE_FALL
+    phase[v > threshold] = PHASE_RISE
+    phase[v < -threshold] = PHASE_FALL
     return phase
 
 
-def cycle_index(phase: IntArray) -> IntArray:
-    """Cycle number at every sample: a cycle starts where a rise starts after rest."""
-    rising = phase == PHASE_RISE
-    starts = np.flatnonzero(rising[1:] & ~rising[:-1]) + 1
-    if rising[0]:
-        starts = np.concatenate([[0], starts])
-    # Merge starts closer than a few samples (jitter at ramp ends) into one.
-    cycle = np.full(phase.size, -1, dtype=np.int64)
-    for k, s in enumerate(starts):
-        cycle[s:] = k
+def cycle_index(x_m: FloatArray) -> IntArray:
+    """Cycle number at every sample (−1 before the first).
+
+    A cycle starts where x rises through 20 % of the stroke, after having been below
+    10 % (hysteresis: noise near the threshold starts no cycle).
+    """
+    low, top = float(x_m.min()), float(x_m.max())
+    up = low + 0.2 * (top - low)
+    down = low + 0.1 * (top - low)
+    cycle = np.full(x_m.size, -1, dtype=np.int64)
+    armed = True
+    k = -1
+    start = 0
+    for i in np.flatnonzero((x_m > up) | (x_m < down)):
+        if x_m[i] > up and armed:
+            cycle[start:i] = k
+            k += 1
+            start = i
+            armed = False
+        elif x_m[i] < down:
+            armed = True
+    cycle[start:] = k
     return cycle
 
 
@@ -145,7 +164,7 @@ def make_trace(name: str, frame: pd.DataFrame, mass_kg: float) -> Trace:
     noise_u = float(np.nanstd(run.u_m[:rest])) if rest > 10 else 0.0
     noise_f = float(np.nanstd(run.force_n[:rest])) if rest > 10 else 0.0
     phase = drive_phases(x_m, run.rate_hz)
-    cycle = cycle_index(phase)
+    cycle = cycle_index(x_m)
     return Trace(
         name=name,
         rate_hz=run.rate_hz,

@@ -17,6 +17,7 @@ As a process: ``labstand stand-sim --json`` (see labstand/commands/stand_sim.py)
 """
 
 from sim.hardware.drive import SimulatedDrive
+from sim.hardware.faults import Fault, FaultKind, parse_fault
 from sim.hardware.gauges import FrontEndSettings, GaugeFrontEnd, StandModel
 from sim.hardware.inprocess import InProcessClient
 from sim.hardware.servo import ServoSettings
@@ -33,6 +34,8 @@ from sim.hardware.stand_model import available_effects, build_stand_model, regis
 __all__ = [
     "Clock",
     "Endpoints",
+    "Fault",
+    "FaultKind",
     "FrontEndSettings",
     "GaugeFrontEnd",
     "InProcessClient",
@@ -45,5 +48,6 @@ __all__ = [
     "StandThread",
     "available_effects",
     "build_stand_model",
+    "parse_fault",
     "register_effect",
 ]

@@ -137,6 +137,17 @@ class PtyWriter:
             log.debug("gauge pty full: %d frames dropped", dropped)
         return dropped
 
+    def inject(self, data: bytes) -> bool:
+        """Send raw bytes between two whole frames (fault injection: line noise).
+
+        Returns False, sending nothing, while a frame is still half sent; what the pty
+        does not take is lost, like noise on a line nobody listens to.
+        """
+        if self._partial:
+            return False
+        self._write(data)
+        return True
+
     def _write(self, data: bytes) -> int:
         try:
             return os.write(self.fd, data)

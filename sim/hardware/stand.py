@@ -32,8 +32,10 @@ from pymodbus.server import ModbusSerialServer, ModbusTcpServer
 from drivers.calibration import GaugeCalibration
 from drivers.gauge_frame import FRAME_SIZE, FRAME_VERSION
 from drivers.limits import DriveLimits
+from drivers.unidrive_profile import ProfileState
 from sim.config import StandConfig
 from sim.hardware.drive import SimulatedDrive
+from sim.hardware.faults import Fault, FaultKind, FaultPlan
 from sim.hardware.gauges import FrontEndSettings, GaugeFrontEnd, PtyWriter
 from sim.hardware.modbus_server import make_device, start_rtu_server, start_tcp_server
 from sim.hardware.pty import PtyBridge, RawPty, open_raw_pty
@@ -84,6 +86,8 @@ class StandSettings:
         Wall time between pacing steps, s.
     effects
         Effect names switched on in the stand model (``sim.hardware.stand_model``).
+    faults
+        Faults to inject once the drive runs a profile (``sim.hardware.faults``).
     """
 
     modbus: str = "tcp://127.0.0.1:0"
@@ -91,6 +95,7 @@ class StandSettings:
     effects: tuple[str, ...] = ()
     frontend: FrontEndSettings = field(default_factory=FrontEndSettings)
     servo: ServoSettings = field(default_factory=ServoSettings)
+    faults: tuple[Fault, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -145,6 +150,11 @@ class SimulatedStand:
         self.endpoints: Endpoints | None = None
         #: Fault injection: while True the simulated drive answers no Modbus request.
         self.modbus_muted = False
+        #: Fault injection: while True the front end sends no frames.
+        self.gauges_silent = False
+        self.faults = FaultPlan(self.settings.faults)
+        self._fault_ends: dict[FaultKind, float] = {}
+        self._garbage = b""
 
     @classmethod
     def from_config(
@@ -207,9 +217,38 @@ class SimulatedStand:
         while due > 0:
             n = min(due, _MAX_BLOCK)
             x = self.drive.advance(n)
-            if self.writer.write(self.frontend.frames(x)):
+            frames = self.frontend.frames(x)
+            if not self.gauges_silent and self.writer.write(frames):
                 self.frontend.overrun_pending = True
             due -= n
+        self._apply_faults()
+
+    def _apply_faults(self) -> None:
+        """Start and end the scheduled faults (``StandSettings.faults``)."""
+        t = self.drive.t_s
+        for kind, end in list(self._fault_ends.items()):
+            if t >= end:
+                del self._fault_ends[kind]
+                self._silence(kind, False)
+        for fault in self.faults.due(t, self.drive.profile_state is ProfileState.RUNNING):
+            log.warning("simulated stand: fault %s at %.3f s", fault, t)
+            if fault.kind is FaultKind.TRIP:
+                self.drive.trip(int(fault.value))
+            elif fault.kind is FaultKind.GARBAGE:
+                rng = np.random.default_rng(int(fault.value))
+                self._garbage += rng.integers(0, 256, int(fault.value), np.uint8).tobytes()
+            else:
+                self._silence(fault.kind, True)
+                if math.isfinite(fault.value):
+                    self._fault_ends[fault.kind] = t + fault.value
+        if self._garbage and self.writer is not None and self.writer.inject(self._garbage):
+            self._garbage = b""
+
+    def _silence(self, kind: FaultKind, on: bool) -> None:
+        if kind is FaultKind.MODBUS_MUTE:
+            self.modbus_muted = on
+        else:
+            self.gauges_silent = on
 
     async def serve(self, stop: asyncio.Event) -> None:
         """Pace the stand until ``stop`` is set."""
@@ -240,6 +279,8 @@ class SimulatedStand:
             "frames": self.frontend.produced,
             "dropped": w.dropped if w else None,
             "trips": [code for _, code in self.drive.trips],
+            "enabled": self.drive.enabled,
+            "x_mm": self.drive.servo.x_m * 1e3,
         }
 
 

@@ -1,0 +1,529 @@
+"""Compiled integrator of the baseline model plus the physical effects of STAND.md §5.
+
+One kernel serves every combination of effects: each parameter row carries a flag per
+effect; inactive effects keep their states at zero and add exact zeros, so with every flag
+off the arithmetic is ``sim.kernel``'s operation for operation (bit-identical results).
+The baseline's event handling is generalised from one fibre to up to two fibre
+*segments* (drive side and weight side, split by the pulley when it has its own degree of
+freedom): each is taut (T = kδ + cδ̇ + q) or slack (T = 0), re-checked at every step's
+start; the earliest switch of any segment, or of the friction branch (v = ±v_reg), is
+located on the cubic Hermite interpolant of the whole state and the step split there.
+Time is i·dt; x is linear inside a sample interval.
+
+State y, an 11-tuple (``Y_*``): weight u, v; pulley rim displacement s, ṡ; Maxwell branch
+forces q₁, q₂; string-mode amplitudes and rates a₁, ȧ₁ (drive span), a₂, ȧ₂ (weight
+span); LuGre bristle z. The run's constants live in one array c: the parameter row
+(``P_*``, ``R_*``), derived constants (``D_*``), the discrete state (``S_*``: taut flags,
+friction branch, pulley-jump seat and slack episode, bearing presliding) and the friction
+table. Stiff effects raise the RK4 substeps per sample from estimates of their fastest
+rates (``_substeps``).
+
+Speed: the hot functions take c and scalars or tuples only; passing arrays to small
+jitted functions costs 7 machine words per array per call (measured: 60 → 9 ms for 10 s
+at 2 kHz). All numba code of the augmented dynamics lives in this one file on purpose:
+numba's cache does not notice changes in jitted functions imported from other modules,
+so splitting it would let stale machine code survive an edit.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+
+# Parameter row: sim.kernel's eight P_* first (same values as sim.model.param_vector), then
+# stand geometry, then per effect a flag (1.0 on) and its parameters in registry order.
+(P_MASS, P_PROJ, P_STIFF, P_DAMP, P_FRICTION_N, P_GRAVITY_N, P_PRELOAD, P_VREG) = range(8)
+(R_DRIVE_SPAN, R_FREE_SPAN, R_FIBRE_LEN, R_LIN_DENSITY, R_SIN_BETA, R_G_PERP_WEIGHT_SPAN,
+ R_GRAVITY, R_SIN_HALF_WRAP, R_RADIUS) = range(8, 17)  # fmt: skip
+(R_VE_ON, R_VE_K, R_VE_TAU) = range(17, 20)
+(R_TV_ON, R_TV_ZETA, R_TV_LOAD, R_TV_TILT) = range(20, 24)
+(R_PJ_ON, R_PJ_STEP, R_PJ_DEPTH) = range(24, 27)
+(R_PI_ON, R_PI_J, R_PI_TORQUE, R_PI_LOAD, R_PI_PRESLIDE) = range(27, 32)
+(R_SS_ON, R_SS_RATIO, R_SS_VS, R_SS_SIGMA) = range(32, 36)
+(R_SL_ON, R_SL_MU) = range(36, 38)
+(R_DG_ON, R_DG_GAIN, R_DG_OFFSET) = range(38, 41)
+(R_CS_ON, R_CS_FORCE, R_CS_DISP) = range(41, 44)
+(R_FG_ON, R_FG_FC, R_FG_ZETA) = range(44, 47)
+N_ROW = 47
+# Derived constants, then the discrete state, then the friction table: indices into c.
+(D_NSEG, D_T0, D_K1, D_C1, D_K2, D_C2, D_D10, D_D20, D_MP, D_FB0, D_FBL, D_SIGP, D_KB1,
+ D_KB2, D_RELAX, D_W1, D_W2, D_F1, D_F2, D_CM1, D_CM2, D_AR1SQ, D_AR2SQ, D_ST1, D_ST2,
+ D_AR1, D_AR2, D_SS_ON, D_SIG0, D_SIG1, D_SL, D_OSC, D_REAL, D_DYN, D_ZONES,
+ ) = range(N_ROW, N_ROW + 35)  # fmt: skip
+(S_TAUT1, S_TAUT2, S_ZONE, S_LOFF, S_LBASE, S_DEPTH, S_PZ, S_PS0) = range(N_ROW + 35, N_ROW + 43)
+C_TABLE = N_ROW + 43  # c[C_TABLE] = knots n, then the n knots, then coef (4, n − 1) by rows
+
+(Y_U, Y_V, Y_S, Y_SD, Y_Q1, Y_Q2, Y_A1, Y_AD1, Y_A2, Y_AD2, Y_Z) = range(11)
+NY = 11
+ZERO = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+NSUB_MAX = 64  # substeps per sample interval at most
+MAX_SWITCH = 8  # regime switches per segment located inside one step (the baseline's 8)
+
+
+@njit(cache=True, error_model="numpy")
+def _mu(speed, c):  # type: ignore[no-untyped-def]
+    """μ(speed) from the PCHIP pieces (as sim.kernel._mu, the table read from c)."""
+    n = int(c[C_TABLE])
+    kn = C_TABLE + 1
+    co = kn + n
+    m = n - 1
+    if speed >= c[kn + n - 1]:
+        s = c[kn + n - 1] - c[kn + n - 2]
+        i = n - 2
+    else:
+        i = 0
+        while i < n - 2 and speed > c[kn + i + 1]:
+            i += 1
+        s = speed - c[kn + i]
+    return ((c[co + i] * s + c[co + m + i]) * s + c[co + 2 * m + i]) * s + c[co + 3 * m + i]
+
+
+@njit(cache=True, error_model="numpy")
+def _zone(v, c):  # type: ignore[no-untyped-def]
+    """Friction branch: +1 sliding up, -1 sliding down, 0 inside the regularisation band."""
+    if c[D_ZONES] == 0.0:
+        return 0
+    if v >= c[P_VREG]:
+        return 1
+    if v <= -c[P_VREG]:
+        return -1
+    return 0
+
+
+@njit(cache=True, error_model="numpy")
+def _friction(v, zone, c):  # type: ignore[no-untyped-def]
+    # The baseline's law with its branch held for the whole step (see sim.kernel).
+    fn = c[P_FRICTION_N]
+    if fn == 0.0:
+        return 0.0
+    if zone > 0:
+        return fn * _mu(v, c)
+    if zone < 0:
+        return -fn * _mu(-v, c)
+    vreg = c[P_VREG]
+    return fn * _mu(vreg, c) * v / vreg
+
+
+@njit(cache=True, error_model="numpy")
+def _string_modes(c, t0):  # type: ignore[no-untyped-def]
+    """Constants of the first string mode of each free span (0 drive side, 1 weight side)."""
+    for span in range(2):
+        if span == 0:  # the drive span hangs vertically, tilted by drive_span_tilt_deg
+            length = c[R_DRIVE_SPAN]
+            g_perp = c[R_GRAVITY] * math.sin(math.radians(c[R_TV_TILT]))
+        else:
+            length = c[R_FREE_SPAN]
+            g_perp = c[R_G_PERP_WEIGHT_SPAN]
+        w = (math.pi / length) ** 2 / c[R_LIN_DENSITY]  # ω² per newton of tension
+        force = 4.0 / math.pi * g_perp * c[R_TV_LOAD]  # modal load per modal mass, m/s²
+        rest = force / (w * t0)
+        c[D_W1 + span] = w
+        c[D_F1 + span] = force
+        c[D_AR1 + span] = rest
+        c[D_AR1SQ + span] = rest * rest
+        c[D_ST1 + span] = math.pi**2 / (4.0 * length)  # geometric stretch = ST·a²
+        c[D_CM1 + span] = 2.0 * c[R_TV_ZETA] * math.sqrt(w * t0)
+
+
+@njit(cache=True, error_model="numpy")
+def pack(row, knots, coef):  # type: ignore[no-untyped-def]
+    """The constants array c of one run: row, derived constants, rest state, table."""
+    n = knots.shape[0]
+    c = np.zeros(C_TABLE + 1 + n + 4 * (n - 1))
+    for i in range(N_ROW):  # scalar loops: slice assignment costs seconds of compile time
+        c[i] = row[i]
+    c[C_TABLE] = n
+    for i in range(n):
+        c[C_TABLE + 1 + i] = knots[i]
+    for r in range(4):
+        for i in range(n - 1):
+            c[C_TABLE + 1 + n + r * (n - 1) + i] = coef[r, i]
+    k, damp = c[P_STIFF], c[P_DAMP]
+    t0 = c[P_GRAVITY_N] / c[P_PROJ]
+    c[D_T0] = t0
+    c[D_NSEG] = 1.0
+    c[D_K1], c[D_C1], c[D_K2], c[D_C2] = k, damp, k, damp
+    c[D_D10], c[D_D20] = c[P_PRELOAD], c[P_PRELOAD]
+    kb = c[R_VE_K] if c[R_VE_ON] > 0.0 else 0.0
+    c[D_KB1], c[D_KB2] = kb, kb
+    osc, real = 0.0, 0.0
+    if c[R_PI_ON] > 0.0:  # two segments; the wrapped arc is shared half and half
+        total, l1, l2 = c[R_FIBRE_LEN], c[R_DRIVE_SPAN], c[R_FREE_SPAN]
+        half = 0.5 * (total - l1 - l2)
+        f1, f2 = total / (l1 + half), total / (l2 + half)
+        c[D_NSEG] = 2.0
+        c[D_K1], c[D_C1], c[D_K2], c[D_C2] = k * f1, damp * f1, k * f2, damp * f2
+        c[D_D10], c[D_D20] = t0 / (k * f1), t0 / (k * f2)
+        c[D_KB1], c[D_KB2] = kb * f1, kb * f2
+        r = c[R_RADIUS]
+        c[D_MP] = c[R_PI_J] / (r * r)
+        c[D_FB0] = c[R_PI_TORQUE] / r
+        c[D_FBL] = c[R_PI_LOAD] * c[R_SIN_HALF_WRAP]
+        c[D_SIGP] = (c[D_FB0] + 2.0 * c[D_FBL] * t0) / c[R_PI_PRESLIDE]
+        stiff = c[D_K1] + c[D_K2] + c[D_KB1] + c[D_KB2] + c[D_SIGP]
+        osc = math.sqrt(stiff / c[D_MP])
+        real = (c[D_C1] + c[D_C2]) / c[D_MP]
+    if c[R_VE_ON] > 0.0:
+        c[D_RELAX] = 1.0 / c[R_VE_TAU]
+        real = max(real, c[D_RELAX])
+    if c[R_TV_ON] > 0.0:
+        _string_modes(c, t0)
+    if c[R_SS_ON] > 0.0 and c[P_FRICTION_N] > 0.0:  # LuGre needs a friction table
+        c[D_SS_ON] = 1.0
+        c[D_SIG0] = c[R_SS_SIGMA]
+        c[D_SIG1] = 2.0 * math.sqrt(c[R_SS_SIGMA] * c[P_MASS])
+        osc = max(osc, math.sqrt(c[R_SS_SIGMA] / c[P_MASS]))
+    if c[R_SL_ON] > 0.0:
+        c[D_SL] = c[R_SL_MU] * c[R_SIN_BETA]
+    c[D_OSC], c[D_REAL] = osc, real
+    on = c[R_VE_ON] + c[R_TV_ON] + c[R_PJ_ON] + c[R_PI_ON] + c[R_SS_ON] + c[R_SL_ON]
+    c[D_DYN] = 1.0 if on > 0.0 else 0.0
+    table = c[P_FRICTION_N] != 0.0 and c[D_SS_ON] == 0.0
+    c[D_ZONES] = 1.0 if table or c[R_SL_ON] > 0.0 else 0.0
+    c[S_TAUT1], c[S_TAUT2] = 1.0, 1.0
+    return c
+
+
+@njit(cache=True, error_model="numpy")
+def rest_state(c):  # type: ignore[no-untyped-def]
+    """Static rest: weight and pulley still, fibre taut at T₀, strings at their gravity sag."""
+    if c[R_TV_ON] > 0.0:
+        return (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, c[D_AR1], 0.0, c[D_AR2], 0.0, 0.0)
+    return ZERO
+
+
+@njit(cache=True, error_model="numpy")
+def _segments(c, y, xa, xb, xd):  # type: ignore[no-untyped-def]
+    """(δ₁, F₁, δ₂, F₂, δ̇₁, δ̇₂): each segment's elongation and tension law at x = xa + xb."""
+    n = c[P_PROJ]
+    ext1, rate1, ext2, rate2 = 0.0, 0.0, 0.0, 0.0
+    if c[R_TV_ON] > 0.0:
+        a1, a2 = y[Y_A1], y[Y_A2]
+        ext1 = c[D_ST1] * (a1 * a1 - c[D_AR1SQ])
+        rate1 = 2.0 * c[D_ST1] * a1 * y[Y_AD1]
+        ext2 = c[D_ST2] * (a2 * a2 - c[D_AR2SQ])
+        rate2 = 2.0 * c[D_ST2] * a2 * y[Y_AD2]
+    if c[R_PJ_ON] > 0.0:
+        ext2 += c[S_LOFF]
+    if c[D_NSEG] < 1.5:
+        d = c[D_D10] + xa + xb - n * y[Y_U] + (ext1 + ext2)
+        dd = xd - n * y[Y_V] + (rate1 + rate2)
+        f = c[D_K1] * d + c[D_C1] * dd + y[Y_Q1]
+        return d, f, d, f, dd, dd
+    d1 = c[D_D10] + xa + xb - y[Y_S] + ext1
+    dd1 = xd - y[Y_SD] + rate1
+    d2 = c[D_D20] + y[Y_S] - n * y[Y_U] + ext2
+    dd2 = y[Y_SD] - n * y[Y_V] + rate2
+    f1 = c[D_K1] * d1 + c[D_C1] * dd1 + y[Y_Q1]
+    f2 = c[D_K2] * d2 + c[D_C2] * dd2 + y[Y_Q2]
+    return d1, f1, d2, f2, dd1, dd2
+
+
+@njit(cache=True, error_model="numpy")
+def _tensions(c, sg):  # type: ignore[no-untyped-def]
+    t1 = sg[1] if c[S_TAUT1] > 0.0 else 0.0
+    if c[D_NSEG] < 1.5:
+        return t1, t1
+    return t1, (sg[3] if c[S_TAUT2] > 0.0 else 0.0)
+
+
+@njit(cache=True, error_model="numpy")
+def _bearing_limit(c, t1, t2):  # type: ignore[no-untyped-def]
+    """Largest bearing presliding displacement at these tensions, m."""
+    return (c[D_FB0] + c[D_FBL] * (max(t1, 0.0) + max(t2, 0.0))) / c[D_SIGP]
+
+
+@njit(cache=True, error_model="numpy")
+def _rhs(c, y, xa, xd):  # type: ignore[no-untyped-def]
+    """dy/dt at drive position xa (rate xd) in the current regimes."""
+    sg = _segments(c, y, xa, 0.0, xd)
+    t1, t2 = _tensions(c, sg)
+    v = y[Y_V]
+    zone = int(c[S_ZONE])
+    zd = 0.0
+    if c[D_SS_ON] > 0.0:  # LuGre replaces the table's friction
+        r = v / c[R_SS_VS]
+        g = c[P_FRICTION_N] * _mu(abs(v), c) * (1.0 + c[R_SS_RATIO] * math.exp(-r * r))
+        zd = v - c[D_SIG0] * abs(v) * y[Y_Z] / g
+        fric = c[D_SIG0] * y[Y_Z] + c[D_SIG1] * math.exp(-r * r) * zd
+    else:
+        fric = _friction(v, zone, c)
+    if c[R_SL_ON] > 0.0:
+        side = c[D_SL] * max(t2, 0.0)
+        fric += side * zone if zone != 0 else side * v / c[P_VREG]
+    drive = -c[P_GRAVITY_N] - fric
+    drive += c[P_PROJ] * t2  # + 0.0 while slack: the baseline's sum, bit for bit
+    acc = drive / c[P_MASS]
+    s_acc, dq1, dq2, aa1, aa2 = 0.0, 0.0, 0.0, 0.0, 0.0
+    if c[D_NSEG] > 1.5:
+        fp = 0.0
+        if c[D_SIGP] > 0.0:
+            zmax = _bearing_limit(c, t1, t2)
+            fp = c[D_SIGP] * min(max(c[S_PZ] + y[Y_S] - c[S_PS0], -zmax), zmax)
+        s_acc = (t1 - t2 - fp) / c[D_MP]
+    if c[R_VE_ON] > 0.0:
+        dq1 = (c[D_KB1] * sg[4] if c[S_TAUT1] > 0.0 else 0.0) - c[D_RELAX] * y[Y_Q1]
+        if c[D_NSEG] > 1.5:
+            dq2 = (c[D_KB2] * sg[5] if c[S_TAUT2] > 0.0 else 0.0) - c[D_RELAX] * y[Y_Q2]
+    if c[R_TV_ON] > 0.0:
+        aa1 = c[D_F1] - c[D_W1] * max(t1, 0.0) * y[Y_A1] - c[D_CM1] * y[Y_AD1]
+        aa2 = c[D_F2] - c[D_W2] * max(t2, 0.0) * y[Y_A2] - c[D_CM2] * y[Y_AD2]
+    return (v, acc, y[Y_SD], s_acc, dq1, dq2, y[Y_AD1], aa1, y[Y_AD2], aa2, zd)
+
+
+@njit(cache=True, error_model="numpy")
+def _axpy(y, a, k):  # type: ignore[no-untyped-def]
+    return (
+        y[0] + a * k[0], y[1] + a * k[1], y[2] + a * k[2], y[3] + a * k[3], y[4] + a * k[4],
+        y[5] + a * k[5], y[6] + a * k[6], y[7] + a * k[7], y[8] + a * k[8], y[9] + a * k[9],
+        y[10] + a * k[10],
+    )  # fmt: skip
+
+
+@njit(cache=True, error_model="numpy")
+def _combine(y, a, k1, k2, k3, k4):  # type: ignore[no-untyped-def]
+    """The RK4 update y + a·(k1 + 2k2 + 2k3 + k4), component by component."""
+    return (
+        y[0] + a * (k1[0] + 2.0 * k2[0] + 2.0 * k3[0] + k4[0]),
+        y[1] + a * (k1[1] + 2.0 * k2[1] + 2.0 * k3[1] + k4[1]),
+        y[2] + a * (k1[2] + 2.0 * k2[2] + 2.0 * k3[2] + k4[2]),
+        y[3] + a * (k1[3] + 2.0 * k2[3] + 2.0 * k3[3] + k4[3]),
+        y[4] + a * (k1[4] + 2.0 * k2[4] + 2.0 * k3[4] + k4[4]),
+        y[5] + a * (k1[5] + 2.0 * k2[5] + 2.0 * k3[5] + k4[5]),
+        y[6] + a * (k1[6] + 2.0 * k2[6] + 2.0 * k3[6] + k4[6]),
+        y[7] + a * (k1[7] + 2.0 * k2[7] + 2.0 * k3[7] + k4[7]),
+        y[8] + a * (k1[8] + 2.0 * k2[8] + 2.0 * k3[8] + k4[8]),
+        y[9] + a * (k1[9] + 2.0 * k2[9] + 2.0 * k3[9] + k4[9]),
+        y[10] + a * (k1[10] + 2.0 * k2[10] + 2.0 * k3[10] + k4[10]),
+    )
+
+
+@njit(cache=True, error_model="numpy")
+def _rk4(c, y, x0, xd, h):  # type: ignore[no-untyped-def]
+    """One RK4 step of length h from y: (new state, dy/dt at the start)."""
+    k1 = _rhs(c, y, x0, xd)
+    xm = x0 + 0.5 * h * xd
+    k2 = _rhs(c, _axpy(y, 0.5 * h, k1), xm, xd)
+    k3 = _rhs(c, _axpy(y, 0.5 * h, k2), xm, xd)
+    k4 = _rhs(c, _axpy(y, h, k3), x0 + h * xd, xd)
+    return _combine(y, h / 6.0, k1, k2, k3, k4), k1
+
+
+# Event functions: which = 0 → δ of segment j, 1 → its tension law, 2 → v − v_reg,
+# 3 → v + v_reg; evaluated on the cubic Hermite interpolant of the step, θ ∈ [0, 1].
+@njit(cache=True, error_model="numpy")
+def _switch_fn(c, theta, y0, f0, y1, f1, x0, xd, h, which, j):  # type: ignore[no-untyped-def]
+    t2 = theta * theta
+    t3 = t2 * theta
+    a, b, d, e = 2 * t3 - 3 * t2 + 1, t3 - 2 * t2 + theta, -2 * t3 + 3 * t2, t3 - t2
+    if which >= 2:
+        v = a * y0[Y_V] + b * h * f0[Y_V] + d * y1[Y_V] + e * h * f1[Y_V]
+        return v - c[P_VREG] if which == 2 else v + c[P_VREG]
+    yi = (
+        a * y0[0] + b * h * f0[0] + d * y1[0] + e * h * f1[0],
+        a * y0[1] + b * h * f0[1] + d * y1[1] + e * h * f1[1],
+        a * y0[2] + b * h * f0[2] + d * y1[2] + e * h * f1[2],
+        a * y0[3] + b * h * f0[3] + d * y1[3] + e * h * f1[3],
+        a * y0[4] + b * h * f0[4] + d * y1[4] + e * h * f1[4],
+        a * y0[5] + b * h * f0[5] + d * y1[5] + e * h * f1[5],
+        a * y0[6] + b * h * f0[6] + d * y1[6] + e * h * f1[6],
+        a * y0[7] + b * h * f0[7] + d * y1[7] + e * h * f1[7],
+        a * y0[8] + b * h * f0[8] + d * y1[8] + e * h * f1[8],
+        a * y0[9] + b * h * f0[9] + d * y1[9] + e * h * f1[9],
+        a * y0[10] + b * h * f0[10] + d * y1[10] + e * h * f1[10],
+    )
+    sg = _segments(c, yi, x0, xd * theta * h, xd)
+    return sg[2 * j] if which == 0 else sg[2 * j + 1]
+
+
+@njit(cache=True, error_model="numpy")
+def _locate(c, y0, f0, y1, f1, x0, xd, h, which, j):  # type: ignore[no-untyped-def]
+    """Bisect the event function's sign change on the step's interpolant; θ of the switch."""
+    lo = 0.0
+    hi = 1.0
+    g_lo = _switch_fn(c, lo, y0, f0, y1, f1, x0, xd, h, which, j)
+    for _ in range(40):
+        mid = 0.5 * (lo + hi)
+        g_mid = _switch_fn(c, mid, y0, f0, y1, f1, x0, xd, h, which, j)
+        if (g_mid > 0.0) == (g_lo > 0.0):
+            lo = mid
+            g_lo = g_mid
+        else:
+            hi = mid
+    return hi
+
+
+@njit(cache=True, error_model="numpy")
+def _set_taut(c, y, x, xd):  # type: ignore[no-untyped-def]
+    """Each segment's regime from the state: taut iff δ > 0 and its tension law > 0."""
+    sg = _segments(c, y, x, 0.0, xd)
+    c[S_TAUT1] = 1.0 if sg[0] > 0.0 and sg[1] > 0.0 else 0.0
+    c[S_TAUT2] = 1.0 if sg[2] > 0.0 and sg[3] > 0.0 else 0.0
+
+
+@njit(cache=True, error_model="numpy")
+def _after_part(c, y, x, xd):  # type: ignore[no-untyped-def]
+    """Update the discrete states at the end of an integrated part of a step."""
+    if c[D_NSEG] > 1.5 and c[D_SIGP] > 0.0:  # bearing presliding (elasto-plastic)
+        t1, t2 = _tensions(c, _segments(c, y, x, 0.0, xd))
+        zmax = _bearing_limit(c, t1, t2)
+        c[S_PZ] = min(max(c[S_PZ] + y[Y_S] - c[S_PS0], -zmax), zmax)
+        c[S_PS0] = y[Y_S]
+    if c[R_PJ_ON] > 0.0:  # re-seating during a geometric slack episode
+        slack = -(c[P_PRELOAD] + x - c[P_PROJ] * y[Y_U] + c[S_LBASE])
+        if slack > 0.0:
+            if slack > c[S_DEPTH]:
+                c[S_DEPTH] = slack
+                base, step = c[S_LBASE], c[R_PJ_STEP]
+                target = step if abs(base) <= abs(base - step) else 0.0  # the other seat
+                c[S_LOFF] = base + (target - base) * (1.0 - math.exp(-slack / c[R_PJ_DEPTH]))
+        elif c[S_DEPTH] > 0.0:  # the episode is over: the fibre stays in its new seat
+            c[S_LBASE] = c[S_LOFF]
+            c[S_DEPTH] = 0.0
+
+
+@njit(cache=True, error_model="numpy")
+def _step(c, y, x0, xd, h):  # type: ignore[no-untyped-def]
+    """Advance y by h, splitting the step at every regime switch (as sim.kernel._step)."""
+    nseg = 2 if c[D_NSEG] > 1.5 else 1
+    remaining = h
+    xs = x0
+    _set_taut(c, y, xs, xd)  # ẋ, and c·δ̇, step at sample boundaries
+    for _ in range(MAX_SWITCH * nseg):
+        zone = int(c[S_ZONE])
+        yn, f0 = _rk4(c, y, xs, xd, remaining)
+        x_end = xs + xd * remaining
+        sg = _segments(c, yn, x_end, 0.0, xd)
+        zone_end = _zone(yn[Y_V], c)
+        theta, first, have_f1 = 2.0, -1, False
+        f1 = ZERO
+        for j in range(nseg):
+            delta_end, force_end = sg[2 * j], sg[2 * j + 1]
+            if c[S_TAUT1 + j] > 0.0:
+                switch = force_end < 0.0
+                which = 1
+            else:
+                switch = delta_end > 0.0 and force_end > 0.0
+                which = 0 if _segments(c, y, xs, 0.0, xd)[2 * j] <= 0.0 else 1
+            if switch:
+                if not have_f1:
+                    f1, have_f1 = _rhs(c, yn, x_end, xd), True
+                th = _locate(c, y, f0, yn, f1, xs, xd, remaining, which, j)
+                if th < theta:
+                    theta, first = th, j
+        if first < 0 and zone_end == zone:
+            _after_part(c, yn, x_end, xd)
+            return yn
+        if zone_end != zone:
+            if not have_f1:
+                f1 = _rhs(c, yn, x_end, xd)
+            # Leaving +1 or entering +1 crosses v = v_reg; otherwise v = −v_reg.
+            zone_which = 2 if (zone == 1 or (zone == 0 and zone_end == 1)) else 3
+            th = _locate(c, y, f0, yn, f1, xs, xd, remaining, zone_which, nseg)  # j unused
+            if th < theta:
+                theta, first = th, -1
+        part = theta * remaining
+        y, _ = _rk4(c, y, xs, xd, part)
+        xs = xs + xd * part
+        _after_part(c, y, xs, xd)
+        remaining = remaining - part
+        if first >= 0:
+            c[S_TAUT1 + first] = 0.0 if c[S_TAUT1 + first] > 0.0 else 1.0
+        else:
+            c[S_ZONE] = zone + 1 if zone_end > zone else zone - 1
+        if remaining <= 1e-15:
+            return y
+    y, _ = _rk4(c, y, xs, xd, remaining)
+    x_end = xs + xd * remaining
+    _set_taut(c, y, x_end, xd)
+    c[S_ZONE] = _zone(y[Y_V], c)
+    _after_part(c, y, x_end, xd)
+    return y
+
+
+@njit(cache=True, error_model="numpy")
+def _substeps(c, y, x, xd, dt, base):  # type: ignore[no-untyped-def]
+    """RK4 steps for the next interval: |λ|·h ≤ 0.5 for oscillations, ≤ 1.5 for decays."""
+    if c[D_DYN] <= 0.0:
+        return base
+    sg = _segments(c, y, x, 0.0, xd)
+    t_est = 1.5 * max(sg[1], sg[3], 0.0) + c[D_T0]
+    osc, real = c[D_OSC], c[D_REAL]
+    strings = abs(y[Y_A1]) + abs(y[Y_AD1]) + abs(y[Y_A2]) + abs(y[Y_AD2]) + abs(c[D_F1] + c[D_F2])
+    if c[R_TV_ON] > 0.0 and strings > 0.0:  # an unexcited string mode stays exactly zero
+        osc = max(osc, math.sqrt(max(c[D_W1], c[D_W2]) * t_est) + c[D_CM1] + c[D_CM2])
+    if c[R_SL_ON] > 0.0:
+        real = max(real, c[D_SL] * t_est / (c[P_VREG] * c[P_MASS]))
+    if c[D_SS_ON] > 0.0:
+        speed = abs(y[Y_V]) + 0.05
+        g_min = c[P_FRICTION_N] * _mu(speed, c)
+        real = max(real, c[D_SIG0] * speed / g_min + c[D_SIG1] / c[P_MASS])
+    n = max(base, math.ceil(dt * osc / 0.5), math.ceil(dt * real / 1.5))
+    return min(n, NSUB_MAX)
+
+
+@njit(cache=True, error_model="numpy")
+def _sample_out(c, y, x, xd, i, out_u, out_v, out_t1, out_t2):  # type: ignore[no-untyped-def]
+    sg = _segments(c, y, x, 0.0, xd)
+    out_u[i] = y[Y_U]
+    out_v[i] = y[Y_V]
+    t1 = sg[1] if c[S_TAUT1] > 0.0 else 0.0
+    out_t1[i] = t1 if t1 > 0.0 else 0.0
+    t2 = t1
+    if c[D_NSEG] > 1.5:
+        t2 = sg[3] if c[S_TAUT2] > 0.0 else 0.0
+    out_t2[i] = t2 if t2 > 0.0 else 0.0
+
+
+@njit(cache=True, error_model="numpy")
+def advance_into(x, dt, substeps, c, state, out_u, out_v, out_t1, out_t2):  # type: ignore[no-untyped-def]
+    """Integrate from the state (array of NY; discrete part in c) at x[0] over x[1:].
+
+    Writes u, v and the drive- and weight-side tensions after each sample into
+    out_*[i + 1] and the final state back into ``state`` and c, so a run can go on block
+    by block. Returns the largest number of substeps one interval took.
+    """
+    y = (
+        state[0], state[1], state[2], state[3], state[4], state[5], state[6], state[7],
+        state[8], state[9], state[10],
+    )  # fmt: skip
+    c[S_ZONE] = _zone(y[Y_V], c)
+    most = 0
+    for i in range(x.shape[0] - 1):
+        xd = (x[i + 1] - x[i]) / dt
+        nsub = _substeps(c, y, x[i], xd, dt, substeps)
+        most = max(most, nsub)
+        h = dt / nsub
+        for j in range(nsub):
+            y = _step(c, y, x[i] + xd * j * h, xd, h)
+        _sample_out(c, y, x[i + 1], xd, i + 1, out_u, out_v, out_t1, out_t2)
+    for k in range(NY):
+        state[k] = y[k]
+    return most
+
+
+@njit(cache=True, error_model="numpy")
+def simulate_into(x, dt, substeps, row, knots, coef, out_u, out_v, out_t1, out_t2):  # type: ignore[no-untyped-def]
+    """Integrate one parameter row from static rest over the drive samples x (relative)."""
+    c = pack(row, knots, coef)
+    y = rest_state(c)
+    out_u[0] = y[Y_U]
+    out_v[0] = y[Y_V]
+    out_t1[0] = c[D_K1] * (c[D_D10] + x[0])  # as sim.kernel: unclamped, no rate term
+    out_t2[0] = out_t1[0] if c[D_NSEG] < 1.5 else c[D_K2] * c[D_D20]
+    state = np.empty(NY)
+    for k in range(NY):
+        state[k] = y[k]
+    return advance_into(x, dt, substeps, c, state, out_u, out_v, out_t1, out_t2)
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def simulate_batch_into(x, dt, substeps, rows, knots, coef, out_u, out_v, out_t1, out_t2):  # type: ignore[no-untyped-def]
+    """simulate_into for each row (and row of x, unless x has one row), in parallel."""
+    for b in prange(rows.shape[0]):
+        xb = x[b] if x.shape[0] > 1 else x[0]
+        simulate_into(
+            xb, dt, substeps, rows[b], knots, coef, out_u[b], out_v[b], out_t1[b], out_t2[b]
+        )

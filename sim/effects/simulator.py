@@ -1,0 +1,292 @@
+"""The augmented simulator: the baseline model plus any combination of effects.
+
+``simulate_augmented`` runs one stand with a list of effects, ``simulate_augmented_batch``
+many (stand, effects) sets in parallel, ``simulate_augmented_rows`` kernel rows directly
+(the fitting path: build rows once with ``augmented_row``, then vary the columns that
+``param_column`` names), and ``AugmentedStream`` advances block by block for the
+simulated stand. Physical effects change the dynamics (``sim.effects.kernel``);
+measurement effects then act on the outputs (``sim.effects.measure``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from sim.effects import kernel as ek
+from sim.effects import measure
+from sim.effects.registry import EFFECTS, EffectError, EffectSpec, check_unique, effect_info
+from sim.model import (
+    DEFAULT_SUBSTEPS,
+    BatchResult,
+    SimResult,
+    _check_input,
+    friction_arrays,
+    param_vector,
+)
+from sim.params import FrictionTable, StandParams
+
+FloatArray = NDArray[np.float64]
+
+__all__ = [
+    "AugmentedBatchResult",
+    "AugmentedResult",
+    "AugmentedStream",
+    "augmented_row",
+    "param_column",
+    "simulate_augmented",
+    "simulate_augmented_batch",
+    "simulate_augmented_rows",
+]
+
+
+@dataclass(frozen=True)
+class AugmentedResult(SimResult):
+    """A SimResult (u_m and force_n as *recorded*) with the true channels beside it.
+
+    Attributes
+    ----------
+    true_u_m
+        Weight displacement before the dial gauge and skew, m.
+    true_force_n
+        Drive-side fibre tension before the force gauge and skew, N.
+    weight_force_n
+        Weight-side tension (differs from the drive side with the pulley's DOF), N.
+    max_substeps
+        Largest number of RK4 substeps one sample interval needed.
+    """
+
+    true_u_m: FloatArray
+    true_force_n: FloatArray
+    weight_force_n: FloatArray
+    max_substeps: int
+
+
+@dataclass(frozen=True)
+class AugmentedBatchResult(BatchResult):
+    """BatchResult (recorded u, F) plus the true channels, shape (sets, samples)."""
+
+    true_u_m: FloatArray
+    true_force_n: FloatArray
+
+
+def param_column(effect: str, param: str) -> int:
+    """Index of an effect parameter in a kernel row (to vary it across a batch)."""
+    return effect_info(effect).param(param).column
+
+
+def augmented_row(stand: StandParams, effects: Sequence[EffectSpec] = ()) -> FloatArray:
+    """The kernel's parameter row for a stand and its effects (checked)."""
+    check_unique(effects)
+    row = np.zeros(ek.N_ROW)
+    row[: ek.R_DRIVE_SPAN] = param_vector(stand)
+    row[ek.R_DRIVE_SPAN] = stand.drive_span_m
+    row[ek.R_FREE_SPAN] = stand.free_length_m
+    row[ek.R_FIBRE_LEN] = stand.fibre_length_m
+    row[ek.R_LIN_DENSITY] = stand.linear_density_kg_m
+    sin_beta = stand.lateral_offset_m / stand.free_length_m
+    row[ek.R_SIN_BETA] = sin_beta
+    # The weight span leaves the weight along the guide (up the incline, share n = cos β)
+    # and sideways (sin β, horizontal): its vertical share is cos β·sin α.
+    vertical = stand.projection * np.sin(np.radians(stand.incline_deg))
+    row[ek.R_G_PERP_WEIGHT_SPAN] = stand.gravity_m_s2 * np.sqrt(1.0 - vertical**2)
+    row[ek.R_GRAVITY] = stand.gravity_m_s2
+    row[ek.R_SIN_HALF_WRAP] = np.sin(np.radians(stand.wrap_angle_deg) / 2)
+    row[ek.R_RADIUS] = stand.pulley_radius_m
+    for spec in effects:
+        info = effect_info(spec.name)
+        row[info.flag_column] = 1.0
+        values = spec.resolved()
+        for p in info.params:
+            row[p.column] = values[p.name]
+    if row[ek.R_PI_ON] > 0 and stand.drive_span_m <= 0:
+        raise EffectError("pulley_inertia_friction needs a positive drive span ℓ₁")
+    return row
+
+
+def _measure_run(
+    u: FloatArray, t1: FloatArray, dt: float, row: FloatArray
+) -> tuple[FloatArray, FloatArray]:
+    out_u, out_f = np.empty_like(u), np.empty_like(t1)
+    measure.measure_into(u, t1, dt, measure.measurement_rows(row)[0], out_u, out_f)
+    return out_u, out_f
+
+
+def simulate_augmented(
+    x_m: FloatArray,
+    rate_hz: float,
+    stand: StandParams,
+    effects: Sequence[EffectSpec] = (),
+    substeps: int = DEFAULT_SUBSTEPS,
+) -> AugmentedResult:
+    """Simulate the stand with effects for a drive position series.
+
+    Parameters
+    ----------
+    x_m
+        Drive position, m, downward positive, shape (N,), sampled at ``rate_hz``.
+    rate_hz
+        Sample rate, Hz.
+    stand
+        The stand's parameters.
+    effects
+        Effects switched on (each at most once); parameters not given take defaults.
+    substeps
+        Least RK4 steps per sample interval (stiff effects take more as needed).
+    """
+    x = _check_input(x_m, rate_hz)
+    n = x.shape[0]
+    row = augmented_row(stand, effects)
+    knots, coef = friction_arrays(stand.friction)
+    u, v, t1, t2 = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
+    most = ek.simulate_into(x, 1.0 / rate_hz, substeps, row, knots, coef, u, v, t1, t2)
+    rec_u, rec_f = _measure_run(u, t1, 1.0 / rate_hz, row)
+    t = np.arange(n) / rate_hz
+    x_out = np.asarray(x_m, dtype=np.float64)
+    t0 = stand.preload_tension_n
+    return AugmentedResult(t, x_out, rec_u, v, rec_f, t0, u, t1, t2, int(most))
+
+
+def simulate_augmented_rows(
+    x_rel_m: FloatArray,
+    rate_hz: float,
+    rows: FloatArray,
+    table: FrictionTable | None,
+    substeps: int = DEFAULT_SUBSTEPS,
+) -> AugmentedBatchResult:
+    """Lowest-level batch entry: kernel rows (``augmented_row``), drive relative to rest.
+
+    ``x_rel_m`` is (N,) shared by all rows or (rows, N); all rows share one friction table.
+    """
+    x2 = np.ascontiguousarray(np.atleast_2d(x_rel_m), dtype=np.float64)
+    rows2 = np.ascontiguousarray(np.atleast_2d(rows), dtype=np.float64)
+    sets, n = rows2.shape[0], x2.shape[1]
+    if x2.shape[0] not in (1, sets):
+        raise EffectError(f"drive rows ({x2.shape[0]}) must be 1 or one per set ({sets})")
+    u, v = np.empty((sets, n)), np.empty((sets, n))
+    t1, t2 = np.empty((sets, n)), np.empty((sets, n))
+    knots, coef = friction_arrays(table)
+    dt = 1.0 / rate_hz
+    ek.simulate_batch_into(x2, dt, substeps, rows2, knots, coef, u, v, t1, t2)
+    rec_u, rec_f = np.empty_like(u), np.empty_like(t1)
+    measure.measure_batch_into(u, t1, dt, measure.measurement_rows(rows2), rec_u, rec_f)
+    return AugmentedBatchResult(np.arange(n) / rate_hz, rec_u, v, rec_f, u, t1)
+
+
+def simulate_augmented_batch(
+    x_m: FloatArray,
+    rate_hz: float,
+    sets: Sequence[tuple[StandParams, Sequence[EffectSpec]]],
+    substeps: int = DEFAULT_SUBSTEPS,
+) -> AugmentedBatchResult:
+    """Simulate many (stand, effects) sets on one drive series (or one per set), in parallel.
+
+    All stands must share one friction table (vary ``friction_scale`` instead).
+    """
+    x = np.asarray(x_m, dtype=np.float64)
+    rel = (
+        _check_input(x, rate_hz)
+        if x.ndim == 1
+        else np.stack([_check_input(row, rate_hz) for row in x])
+    )
+    tables = {stand.friction for stand, _ in sets if stand.friction is not None}
+    if len(tables) > 1:
+        raise EffectError("a batch must share one friction table (vary friction_scale)")
+    table = next(iter(tables)) if tables else None
+    rows = np.stack([augmented_row(stand, effects) for stand, effects in sets])
+    return simulate_augmented_rows(rel, rate_hz, rows, table, substeps)
+
+
+class AugmentedStream:
+    """The augmented model advanced block by block (for the simulated stand).
+
+    Starts at static rest with the drive at ``x0_m``; each ``advance`` takes the drive
+    positions of the next samples and returns the *recorded* u (m) and F (N) at them,
+    equal to one ``simulate_augmented`` call over the concatenated blocks. A stream
+    cannot look ahead, so a negative channel skew (a channel recorded early) is refused.
+    """
+
+    def __init__(
+        self,
+        stand: StandParams,
+        rate_hz: float,
+        effects: Sequence[EffectSpec] = (),
+        x0_m: float = 0.0,
+        substeps: int = DEFAULT_SUBSTEPS,
+    ) -> None:
+        if not (np.isfinite(rate_hz) and rate_hz > 0):
+            raise EffectError(f"sample rate must be > 0 Hz, got {rate_hz}")
+        self.stand = stand
+        self.rate_hz = rate_hz
+        self.effects = tuple(effects)
+        self._row = augmented_row(stand, effects)
+        self._m = measure.measurement_rows(self._row)[0]
+        self._skews = (self._m[measure.M_SKEW_U], self._m[measure.M_SKEW_F])
+        if self._m[measure.M_CS_ON] > 0 and min(self._skews) < 0:
+            raise EffectError("a stream cannot record a channel early (negative skew)")
+        knots, coef = friction_arrays(stand.friction)
+        self._c = ek.pack(self._row, knots, coef)
+        self._y = np.array(ek.rest_state(self._c), dtype=np.float64)
+        self._substeps = substeps
+        self._x0 = x0_m
+        self._last_x = x0_m
+        t0 = self._c[ek.D_K1] * self._c[ek.D_D10]  # the force at sample 0, as simulate_into
+        self._gauge = np.array([t0, 0.0, t0])  # filter state (y, ẏ, previous input)
+        u_rest = self._m[measure.M_OFFSET] if self._m[measure.M_DG_ON] > 0 else 0.0
+        depth = int(np.ceil(max(self._skews) * rate_hz)) + 2
+        self._hist_u = np.full(depth, u_rest)
+        self._hist_f = np.full(depth, t0)
+
+    @property
+    def velocity_m_s(self) -> float:
+        """Weight velocity after the last sample, m/s."""
+        return float(self._y[ek.Y_V])
+
+    def advance(self, x_block_m: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """Recorded weight displacement u (m) and force F (N) at the next samples."""
+        block = np.ascontiguousarray(x_block_m, dtype=np.float64)
+        if block.ndim != 1 or not np.all(np.isfinite(block)):
+            raise EffectError("drive positions must be a finite 1-D block")
+        n = block.shape[0]
+        x = np.empty(n + 1)
+        x[0] = self._last_x
+        x[1:] = block
+        x -= self._x0
+        u, v, t1, t2 = (np.empty(n + 1) for _ in range(4))
+        dt = 1.0 / self.rate_hz
+        ek.advance_into(x, dt, self._substeps, self._c, self._y, u, v, t1, t2)
+        if n:
+            self._last_x = float(block[-1])
+        return self._measure(u[1:], t1[1:], dt)
+
+    def _measure(
+        self, u: FloatArray, force: FloatArray, dt: float
+    ) -> tuple[FloatArray, FloatArray]:
+        m = self._m
+        gu = (1.0 + m[measure.M_GAIN]) * u + m[measure.M_OFFSET] if m[measure.M_DG_ON] > 0 else u
+        gf = force.copy()
+        if m[measure.M_FG_ON] > 0:
+            measure.gauge_filter_into(
+                force, dt, m[measure.M_FC], m[measure.M_ZETA], self._gauge, gf
+            )
+        if m[measure.M_CS_ON] <= 0:
+            return gu, gf
+        out = []
+        for hist, series, skew in (
+            (self._hist_u, gu, self._skews[0]),
+            (self._hist_f, gf, self._skews[1]),
+        ):
+            ext = np.concatenate([hist, series])
+            rec = np.empty(series.shape[0])
+            measure.skew_into(ext, hist.shape[0], skew / dt, rec)
+            hist[:] = ext[ext.shape[0] - hist.shape[0] :]
+            out.append(rec)
+        return out[0], out[1]
+
+
+def known_effects() -> list[str]:
+    """Effect names in STAND.md order."""
+    return list(EFFECTS)
