@@ -17,9 +17,12 @@ $(STAMP): pyproject.toml requirements.lock
 	$(BIN)/python -m pip install --quiet --no-deps -e .
 	touch $(STAMP)
 
+# A full test on the simulated stand (started and stopped by labstand run itself), then
+# its replay against the model.
 demo: $(STAMP)
 	@mkdir -p $(OUT)
-	$(BIN)/labstand simulate --situation 11 -o $(OUT)/situation-11.csv --plot $(OUT)/situation-11.png
+	$(BIN)/labstand run --backend sim --situation 11 --note "make demo" -o $(OUT)/run-11.mcap
+	$(BIN)/labstand replay $(OUT)/run-11.mcap --plot $(OUT)/replay-11.png
 
 # Debian tools the tests use as independent peers; installed here, never assumed.
 system-tools:

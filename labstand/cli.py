@@ -24,6 +24,7 @@ COMMANDS = [
     "simulate",
     "model",
     "stand_sim",
+    "run",
     "replay",
     "compare",
     "table1",
@@ -50,6 +51,13 @@ def build_parser() -> argparse.ArgumentParser:
     for name in COMMANDS:
         importlib.import_module(f"labstand.commands.{name}").register(sub)
     return parser
+
+
+_PREFIXES = {
+    ExitCode.REFUSED: "refused",
+    ExitCode.ESTOP: "e-stop",
+    ExitCode.INTERRUPTED: "interrupted",
+}
 
 
 def _error_code(err: Exception) -> ExitCode:
@@ -86,9 +94,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     ) as err:
         if args.verbose:
             log.exception("command failed")
-        prefix = "refused" if isinstance(err, LimitError) else "error"
+        code = _error_code(err)
+        prefix = _PREFIXES.get(code, "error")
         print(f"labstand: {prefix}: {err}", file=sys.stderr)
-        return _error_code(err)
+        return code
     return code
 
 

@@ -9,25 +9,18 @@ from pathlib import Path
 
 import numpy as np
 
+from labstand.plots import pyplot
 from recordings.diagnosis import Diagnosis, Trace
 from recordings.diagnosis.traces import PHASES
 
 PHASE_COLOURS = {"rise": "tab:red", "hold": "tab:orange", "fall": "tab:blue", "rest": "tab:gray"}
 
 
-def _pyplot():  # type: ignore[no-untyped-def]
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
-
-
 def _residual_plot(path: Path, traces: Sequence[Trace], result: Diagnosis) -> None:
-    plt = _pyplot()
-    fig, axes = plt.subplots(2 * len(traces), 1, figsize=(11, 3.2 * len(traces)), squeeze=False,
-                             constrained_layout=True)
+    plt = pyplot()
+    fig, axes = plt.subplots(
+        2 * len(traces), 1, figsize=(11, 3.2 * len(traces)), squeeze=False, constrained_layout=True
+    )
     for i, (tr, out) in enumerate(zip(traces, result.outputs_before, strict=True)):
         t = np.arange(tr.samples) / tr.rate_hz
         for j, (name, rec, sim, unit) in enumerate(
@@ -39,8 +32,15 @@ def _residual_plot(path: Path, traces: Sequence[Trace], result: Diagnosis) -> No
                 sel = tr.phase == k
                 ax.scatter(t[sel], res[sel], s=0.4, color=PHASE_COLOURS[phase], label=phase)
             held = ~tr.train
-            ax.fill_between(t, np.nanmin(res), np.nanmax(res), where=held, color="k", alpha=0.06,
-                            label="held out")
+            ax.fill_between(
+                t,
+                np.nanmin(res),
+                np.nanmax(res),
+                where=held,
+                color="k",
+                alpha=0.06,
+                label="held out",
+            )
             ax.set_ylabel(f"{name} residual [{unit}]")
             ax.set_title(f"{tr.name}: fitted baseline − recorded", fontsize=9)
             ax.grid(alpha=0.3)
@@ -52,7 +52,7 @@ def _residual_plot(path: Path, traces: Sequence[Trace], result: Diagnosis) -> No
 
 
 def _ranking_plot(path: Path, result: Diagnosis) -> None:
-    plt = _pyplot()
+    plt = pyplot()
     names = [r["effect"] for r in result.ranking]
     screening = [r["screening"] for r in result.ranking]
     scores = [r["score"] if r["score"] is not None else 0.0 for r in result.ranking]
@@ -70,16 +70,19 @@ def _ranking_plot(path: Path, result: Diagnosis) -> None:
 
 
 def _overlay_plot(path: Path, traces: Sequence[Trace], result: Diagnosis) -> None:
-    plt = _pyplot()
-    fig, axes = plt.subplots(2 * len(traces), 1, figsize=(11, 3.2 * len(traces)), squeeze=False,
-                             constrained_layout=True)
+    plt = pyplot()
+    fig, axes = plt.subplots(
+        2 * len(traces), 1, figsize=(11, 3.2 * len(traces)), squeeze=False, constrained_layout=True
+    )
     for i, tr in enumerate(traces):
         t = np.arange(tr.samples) / tr.rate_hz
         before, after = result.outputs_before[i], result.outputs_after[i]
-        for j, (name, rec, b, a) in enumerate((
-            ("u [mm]", tr.u_m * 1e3, before.u_m * 1e3, after.u_m * 1e3),
-            ("F [N]", tr.force_n, before.force_n, after.force_n),
-        )):
+        for j, (name, rec, b, a) in enumerate(
+            (
+                ("u [mm]", tr.u_m * 1e3, before.u_m * 1e3, after.u_m * 1e3),
+                ("F [N]", tr.force_n, before.force_n, after.force_n),
+            )
+        ):
             ax = axes[2 * i + j, 0]
             ax.plot(t, rec, color="k", lw=0.8, label="recorded")
             ax.plot(t, b, color="tab:blue", lw=0.8, ls="--", label="baseline (fitted)")
@@ -126,8 +129,9 @@ def write_report(directory: Path, traces: Sequence[Trace], result: Diagnosis) ->
     )
     page = f"""<!doctype html>
 <html><head><meta charset="utf-8"><title>labstand diagnosis: {html.escape(result.effect)}</title>
-<style>body{{font-family:sans-serif;max-width:1150px;margin:auto}} td,th{{padding:2px 8px;
-text-align:left}} table{{border-collapse:collapse;margin:6px 0}} tr:nth-child(even){{background:#f3f3f3}}</style>
+<style>body{{font-family:sans-serif;max-width:1150px;margin:auto}}
+td,th{{padding:2px 8px;text-align:left}} table{{border-collapse:collapse;margin:6px 0}}
+tr:nth-child(even){{background:#f3f3f3}}</style>
 </head><body>
 <h1>Diagnosis: <code>{html.escape(result.effect)}</code></h1>
 <p>Recordings: {", ".join(html.escape(t.name) for t in traces)}.
@@ -137,7 +141,8 @@ bootstrap confidence {result.confidence:.2f}).</p>
 <h2>How far the gap shrinks (held-out cycles)</h2>
 <h3>before</h3>{_table(data["gap_before"])}<h3>after</h3>{_table(data["gap_after"])}
 <h2>Which effect</h2><img src="ranking.png" alt="ranking">
-<table><tr><th>effect</th><th>held-out gap closure</th><th>screening</th><th>fitted parameters</th></tr>
+<table><tr><th>effect</th><th>held-out gap closure</th><th>screening</th>
+<th>fitted parameters</th></tr>
 {ranking_rows}</table>
 <h2>Where the gap lies</h2>
 <p>Shares of the fitted baseline's squared residual.</p>

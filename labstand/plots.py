@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
+from types import ModuleType
 
 from recordings.replay import ReplayResult
 from sim.model import SimResult
@@ -10,12 +11,19 @@ from sim.model import SimResult
 _UNITS = {"u": "weight u [mm]", "F": "fibre force F [N]", "F_dyn": "dynamic force F − T₀ [N]"}
 
 
-def plot_run(path: Path, result: SimResult, title: str) -> None:
-    """Drive position, weight displacement and fibre force over time, one panel each."""
+def pyplot() -> ModuleType:
+    """matplotlib.pyplot on the file-only backend: the CLI draws into files, never windows."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+
+    return plt
+
+
+def plot_run(path: Path, result: SimResult, title: str) -> None:
+    """Drive position, weight displacement and fibre force over time, one panel each."""
+    plt = pyplot()
 
     fig, axes = plt.subplots(3, 1, sharex=True, figsize=(10, 7), constrained_layout=True)
     axes[0].plot(result.t_s, result.x_m * 1e3, color="tab:gray")
@@ -53,10 +61,7 @@ def plot_replay(
     first_label: str = "recorded",
 ) -> None:
     """Recorded vs simulated u and F − T₀ (like the paper's figures), with the residuals."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     channels = ("u", "F_dyn")
     fig, axes = plt.subplots(

@@ -22,7 +22,14 @@ from drivers.calibration import GaugeCalibration
 from drivers.limits import DriveLimits
 from sim.params import FrictionTable, StandParams
 
-__all__ = ["ConfigError", "ParameterSet", "StandConfig", "default_config", "load_config"]
+__all__ = [
+    "ConfigError",
+    "DeviceConfig",
+    "ParameterSet",
+    "StandConfig",
+    "default_config",
+    "load_config",
+]
 
 #: The drive's mechanical stroke [paper]; a configured limit beyond it is refused.
 STROKE_MAX_MM = 90.0
@@ -41,6 +48,29 @@ class ParameterSet:
     stiffness_n_m: float
     damping_n_s_m: float
     friction: str  # a [friction.NAME] table, or "none"
+
+
+@dataclass(frozen=True)
+class DeviceConfig:
+    """Where the real stand's devices are: the optional ``[devices]`` table.
+
+    A stand file without it describes no hardware, and ``labstand run`` uses the
+    simulated stand.
+
+    Attributes
+    ----------
+    drive
+        The Unidrive SP: ``tcp://HOST[:PORT]`` (Modbus TCP) or
+        ``rtu:///dev/ttyUSB1[?baudrate=115200&stopbits=2&parity=N]`` (Modbus RTU).
+    gauges
+        The gauge front end's serial port, e.g. ``/dev/ttyUSB0``.
+    gauges_baudrate
+        Its line speed, baud (2 kHz × 24-byte frames need ≥ 480 000).
+    """
+
+    drive: str
+    gauges: str
+    gauges_baudrate: int = 921_600
 
 
 Check = Callable[[Any], str | None]  # returns a complaint, or None when the value is fine
@@ -74,6 +104,29 @@ def _number_list(value: Any) -> str | None:
     return None
 
 
+def _drive_url(value: Any) -> str | None:
+    if not isinstance(value, str) or not value.startswith(("tcp://", "rtu://")):
+        return f"must be a tcp://HOST:PORT or rtu://PATH URL, got {value!r}"
+    return None
+
+
+def _port(value: Any) -> str | None:
+    if not isinstance(value, str) or not value.strip():
+        return f"must be a serial port path, got {value!r}"
+    return None
+
+
+def _baudrate(value: Any) -> str | None:
+    if isinstance(value, bool) or not isinstance(value, int) or value <= 0:
+        return f"must be a positive whole number of baud, got {value!r}"
+    return None
+
+
+_DEVICE_KEYS: dict[str, Check] = {
+    "drive": _drive_url,
+    "gauges": _port,
+    "gauges_baudrate": _baudrate,
+}
 POSITIVE = _number(0.0)
 NON_NEGATIVE = _number(0.0, strict=False)
 ANY_NUMBER = _number()
@@ -132,6 +185,7 @@ class StandConfig:
     gauges: GaugeCalibration
     source: str
     raw: Mapping[str, Any]
+    devices: DeviceConfig | None = None
 
     @property
     def default_mass_kg(self) -> float:
@@ -206,7 +260,7 @@ def _friction_table(source: str, name: str, data: dict[str, Any]) -> FrictionTab
 def config_from_dict(data: Mapping[str, Any], source: str = DEFAULT_SOURCE) -> StandConfig:
     """Validate an overlay on the defaults and build the configuration."""
     merged = _merge(_default_data(), data)
-    allowed = set(_FIXED_TABLES) | set(_NAMED_TABLES) | {"weights_kg"}
+    allowed = set(_FIXED_TABLES) | set(_NAMED_TABLES) | {"weights_kg", "devices"}
     for key in merged:
         if key not in allowed:
             raise ConfigError(
@@ -257,7 +311,21 @@ def config_from_dict(data: Mapping[str, Any], source: str = DEFAULT_SOURCE) -> S
         gauges=GaugeCalibration(**{k: float(v) for k, v in gauges.items()}),
         source=source,
         raw=merged,
+        devices=_devices(source, merged.get("devices")),
     )
+
+
+def _devices(source: str, table: Any) -> DeviceConfig | None:
+    """The optional [devices] table: drive and gauges required, gauges_baudrate optional."""
+    if table is None:
+        return None
+    full = (
+        {"gauges_baudrate": DeviceConfig.gauges_baudrate, **table}
+        if isinstance(table, dict)
+        else table
+    )
+    _check_table(source, "devices", full, _DEVICE_KEYS)
+    return DeviceConfig(full["drive"], full["gauges"], full["gauges_baudrate"])
 
 
 def _default_data() -> dict[str, Any]:

@@ -30,6 +30,7 @@ The price is a longer first compile (≈ 12 s, cached in __pycache__ afterwards)
 
 from __future__ import annotations
 
+import numpy as np
 from numba import njit, prange
 
 P_MASS, P_PROJ, P_STIFF, P_DAMP, P_FRICTION_N, P_GRAVITY_N, P_PRELOAD, P_VREG = range(8)
@@ -244,3 +245,42 @@ def simulate_batch_into(x, dt, substeps, params, knots, coef, out_u, out_v, out_
     for b in prange(params.shape[0]):
         xb = x[b] if x.shape[0] > 1 else x[0]
         simulate_into(xb, dt, substeps, params[b], knots, coef, out_u[b], out_v[b], out_t[b])
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def simulate_segments_into(x, dt, substeps, params, knots, coef, starts, lens, init, out_u, out_t):  # type: ignore[no-untyped-def]
+    """Many short runs (segments) of many parameter sets, in parallel over (set, segment).
+
+    Segment s covers the samples starts[s] … starts[s] + lens[s] − 1 of the relative
+    drive x; a segment at sample 0 starts from static rest (as ``simulate_into``), any
+    other for set b from the state init[b, s] = (u, v) (the taut flag follows from the
+    state, as in every step). Writes u and T into out_*[b, s, :lens[s]] and
+    holds the last value to the end of the row (so a measurement transform over the
+    padded row sees the run "held beyond its end").
+    """
+    sets = params.shape[0]
+    segs = starts.shape[0]
+    for flat in prange(sets * segs):
+        b = flat // segs
+        s = flat % segs
+        p = params[b]
+        n = lens[s]
+        xs = x[starts[s] : starts[s] + n]
+        u0, v0 = init[b, s, 0], init[b, s, 1]
+        scratch_v = np.empty(n)
+        ou = out_u[b, s]
+        ot = out_t[b, s]
+        if starts[s] == 0:  # from static rest, exactly as an open-loop run
+            simulate_into(xs, dt, substeps, p, knots, coef, ou, scratch_v, ot)
+        else:
+            ou[0] = u0
+            scratch_v[0] = v0
+            xd = (xs[1] - xs[0]) / dt if n > 1 else 0.0
+            delta = p[P_PRELOAD] + xs[0] - p[P_PROJ] * u0
+            t0 = p[P_STIFF] * delta + p[P_DAMP] * (xd - p[P_PROJ] * v0)
+            ot[0] = t0 if delta > 0.0 and t0 > 0.0 else 0.0
+            if n > 1:
+                advance_into(xs, dt, substeps, p, knots, coef, u0, v0, True, ou, scratch_v, ot)
+        for i in range(n, ou.shape[0]):
+            ou[i] = ou[n - 1]
+            ot[i] = ot[n - 1]

@@ -222,3 +222,52 @@ class ModelStream:
         if block.shape[0]:
             self._last_x = float(block[-1])
         return u[1:], f[1:]
+
+
+def simulate_segment_rows(
+    x_rel_m: FloatArray,
+    rate_hz: float,
+    rows: FloatArray,
+    table: FrictionTable | None,
+    starts: NDArray[np.int64],
+    lengths: NDArray[np.int64],
+    init: FloatArray,
+    substeps: int = DEFAULT_SUBSTEPS,
+) -> tuple[FloatArray, FloatArray]:
+    """Many short runs from given states (multiple shooting), all in one parallel batch.
+
+    Parameters
+    ----------
+    x_rel_m
+        Drive position relative to rest, m, shape (N,).
+    rate_hz
+        Sample rate, Hz.
+    rows
+        Kernel parameter rows (``param_vector``), shape (sets, N_PARAMS).
+    table
+        The friction table all rows share.
+    starts, lengths
+        First sample and number of samples of each segment, shape (segments,).
+    init
+        Start state (u m, v m/s) of each set's segment, shape (sets, segments, 2); a
+        segment starting at sample 0 starts from static rest instead.
+    substeps
+        RK4 steps per sample interval.
+
+    Returns
+    -------
+    u, force
+        Weight displacement (m) and tension (N), shape (sets, segments, max length);
+        each segment's last value is held to the end of its row.
+    """
+    rows2 = np.ascontiguousarray(np.atleast_2d(rows), dtype=np.float64)
+    sets, segs, width = rows2.shape[0], starts.shape[0], int(lengths.max())
+    u, f = np.empty((sets, segs, width)), np.empty((sets, segs, width))
+    knots, coef = friction_arrays(table)
+    kernel.simulate_segments_into(
+        np.ascontiguousarray(x_rel_m, dtype=np.float64), 1.0 / rate_hz, substeps, rows2,
+        knots, coef, np.ascontiguousarray(starts, dtype=np.int64),
+        np.ascontiguousarray(lengths, dtype=np.int64),
+        np.ascontiguousarray(init, dtype=np.float64), u, f,
+    )  # fmt: skip
+    return u, f

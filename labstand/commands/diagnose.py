@@ -23,12 +23,19 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
         "recordings of one stand, say where the remaining gap lies, which of the nine "
         "candidate effects explains it (judged on held-out cycles), and how far it shrinks.",
     )
-    parser.add_argument("recordings", type=Path, nargs="+", help="recordings (.mcap .h5 .csv .tdms)")
-    parser.add_argument("--stand", type=Path, metavar="FILE",
-                        help="nominal stand (default: the paper's, 'final' parameters)")
+    parser.add_argument(
+        "recordings", type=Path, nargs="+", help="recordings (.mcap .h5 .csv .tdms)"
+    )
+    parser.add_argument(
+        "--stand",
+        type=Path,
+        metavar="FILE",
+        help="nominal stand (default: the paper's, 'final' parameters)",
+    )
     parser.add_argument("--params", default="final", help="nominal parameter set (final)")
-    parser.add_argument("--mass-kg", type=float,
-                        help="weight mass, kg (default: each recording's stored weight)")
+    parser.add_argument(
+        "--mass-kg", type=float, help="weight mass, kg (default: each recording's stored weight)"
+    )
     parser.add_argument("--json", action="store_true", help="print the result as JSON")
     parser.add_argument("--report", type=Path, metavar="DIR", help="write an HTML report here")
     parser.set_defaults(func=run)
@@ -59,7 +66,9 @@ def run(args: argparse.Namespace) -> int:
             raise CommandError(str(err), ExitCode.USAGE) from None
     names = [t.name for t in traces]
     if len(set(names)) != len(names):
-        traces = [t.__class__(**{**t.__dict__, "name": f"{i}:{t.name}"}) for i, t in enumerate(traces)]
+        traces = [
+            t.__class__(**{**t.__dict__, "name": f"{i}:{t.name}"}) for i, t in enumerate(traces)
+        ]
 
     def progress(message: str) -> None:
         print(f"labstand diagnose: {message}", file=sys.stderr, flush=True)
@@ -84,7 +93,10 @@ def _print_summary(out: dict[str, object]) -> None:
     print("Held-out gap        before            after")
     for ch in ("u", "F"):
         b, a = before[ch], after[ch]  # type: ignore[index]
-        print(f"  {ch}: NRMSE {b['nrmse']:.4f}  R {b['R']:.5f}   NRMSE {a['nrmse']:.4f}  R {a['R']:.5f}")
+        print(
+            f"  {ch}: NRMSE {b['nrmse']:.4f}  R {b['R']:.5f}"
+            f"   NRMSE {a['nrmse']:.4f}  R {a['R']:.5f}"
+        )
     print("Ranking (score = held-out gap closure; screening = share of residual explained):")
     for r in out["ranking"][:5]:  # type: ignore[index]
         score = "   —  " if r["score"] is None else f"{r['score']:6.3f}"

@@ -23,12 +23,26 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     add_stand_options(parser)
     parser.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     parser.add_argument("--trials", type=int, default=1, help="campaigns per class and mass (1)")
-    parser.add_argument("--effects", nargs="+", choices=CLASSES, default=CLASSES, metavar="NAME",
-                        help="classes to check (default: all nine effects and none)")
-    parser.add_argument("--mass-kg", type=float, nargs="+", default=list(MASSES_KG),
-                        help="weight masses (default: 3.096 8.131)")
-    parser.add_argument("--small", action="store_true",
-                        help="short campaigns (two recordings, ~9 s): quicker, less sure")
+    parser.add_argument(
+        "--effects",
+        nargs="+",
+        choices=CLASSES,
+        default=CLASSES,
+        metavar="NAME",
+        help="classes to check (default: all nine effects and none)",
+    )
+    parser.add_argument(
+        "--mass-kg",
+        type=float,
+        nargs="+",
+        default=list(MASSES_KG),
+        help="weight masses (default: 3.096 8.131)",
+    )
+    parser.add_argument(
+        "--small",
+        action="store_true",
+        help="short campaigns (two recordings, ~9 s): quicker, less sure",
+    )
     parser.add_argument("--json", action="store_true", help="print JSON (accuracy, confusion, ...)")
     parser.add_argument("-o", "--output", type=Path, help="also write the JSON here")
     parser.set_defaults(func=run)
@@ -52,10 +66,14 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps(out, indent=2))
         return 0
-    print(f"{out['cases']} blind campaigns (seed {args.seed}): top-1 accuracy {out['accuracy']:.2f}, "
-          f"false alarms on none {out['false_alarm_rate']:.2f}")
-    print(f"median NRMSE shrink (correct answers) {out['median_shrink']:.2f}, "
-          f"the true model's {out['oracle_median_shrink']:.2f}")
+    print(
+        f"{out['cases']} blind campaigns (seed {args.seed}): top-1 accuracy {out['accuracy']:.2f}, "
+        f"false alarms on none {out['false_alarm_rate']:.2f}"
+    )
+    print(
+        f"median NRMSE shrink (correct answers) {out['median_shrink']:.2f}, "
+        f"the true model's {out['oracle_median_shrink']:.2f}"
+    )
     labels = list(out["confusion"])
     short = [name[:6] for name in labels]
     print("confusion (rows: truth, columns: answer):")

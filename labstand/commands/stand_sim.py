@@ -29,10 +29,16 @@ from typing import Any, Self, TextIO
 
 from labstand.commands.common import add_stand_options, load_stand
 from labstand.errors import CommandError
+from sim.hardware.faults import parse_fault
 from sim.hardware.gauges import FrontEndSettings
 from sim.hardware.stand import ScaledClock, SimulatedStand, StandSettings
 
 PARENT_POLL_S = 0.2
+#: After its parent died, how long an enabled simulated drive may take to stop (its
+#: watchdog trips within 1 s) before the process exits anyway, wall s.
+ORPHAN_GRACE_S = 3.0
+#: ... and how long it then goes on answering, so an observer can read why it stopped.
+ORPHAN_LINGER_S = 1.0
 
 
 def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -67,6 +73,14 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
         help="simulated seconds per wall second (default 1: real time)",
     )
     parser.add_argument("--seed", type=int, default=0, help="gauge noise seed (default 0)")
+    parser.add_argument(
+        "--fault",
+        action="append",
+        default=[],
+        metavar="KIND@T[:VALUE]",
+        help="for tests: inject a fault T s after the drive starts a profile: trip, "
+        "gauges-silent, garbage, modbus-mute (sim/hardware/faults.py; repeatable)",
+    )
     parser.add_argument("--json", action="store_true", help="print the endpoints as one JSON line")
     parser.add_argument(
         "--parent-pid",
@@ -113,8 +127,14 @@ async def _serve(stand: SimulatedStand, args: argparse.Namespace) -> None:
         first_parent = os.getppid()
         while not stop.is_set():
             if not _alive(pid) or os.getppid() != first_parent:
-                stop.set()
                 _say(f"labstand stand-sim: parent {pid} is gone; stopping", sys.stderr)
+                # like the real drive, stop by the watchdog first (observable over Modbus)
+                deadline = loop.time() + ORPHAN_GRACE_S
+                if stand.drive.enabled:
+                    while stand.drive.enabled and loop.time() < deadline:
+                        await asyncio.sleep(0.05)
+                    await asyncio.sleep(ORPHAN_LINGER_S)
+                stop.set()
             await asyncio.sleep(PARENT_POLL_S)
 
     watcher = asyncio.create_task(watch_parent(args.parent_pid)) if args.parent_pid else None
@@ -136,6 +156,7 @@ def run_stand_sim(args: argparse.Namespace) -> int:
     settings = StandSettings(
         modbus=args.modbus,
         effects=tuple(args.effect),
+        faults=tuple(parse_fault(f) for f in args.fault),
         frontend=FrontEndSettings(rate_hz=config.sample_rate_hz, seed=args.seed),
     )
     stand = SimulatedStand.from_config(
@@ -175,8 +196,14 @@ class StandProcess:
 
     def start(self) -> dict[str, Any]:
         """Start the child and return its ready line (endpoints)."""
+        # A session of its own: Ctrl-C at the terminal reaches the parent alone, which
+        # then stops the run in order while the simulated stand keeps serving.
         self.process = subprocess.Popen(
-            self.args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+            self.args,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+            start_new_session=True,
         )
         assert self.process.stdout is not None
         ready, _, _ = select.select([self.process.stdout], [], [], self._timeout)

@@ -1,5 +1,6 @@
-"""The check on withheld effects: generate campaigns whose truth is known, diagnose them
-blind, and score the answers.
+"""The check on withheld effects: campaigns with known truth, diagnosed blind, scored.
+
+Each campaign is generated, diagnosed without its answer, and the answer scored.
 
 For every effect and for ``none``, at each weight mass, a campaign is drawn: a "real"
 stand (stiffness, damping and friction scale off nominal by up to ±25 %), the effect at
@@ -43,7 +44,10 @@ FULL_CAMPAIGN = (
 )
 #: A shorter campaign for the test suite (~9 s).
 SMALL_CAMPAIGN = (
-    ("quick", SignalSpec(Shape.TRAPEZOIDAL, 0.025, 2.0, cycles=4, ramp_fraction=0.4, dwell_end_s=0.5)),
+    (
+        "quick",
+        SignalSpec(Shape.TRAPEZOIDAL, 0.025, 2.0, cycles=4, ramp_fraction=0.4, dwell_end_s=0.5),
+    ),
     ("slow", SignalSpec(Shape.QUASI_SINUSOIDAL, 0.060, 0.5, cycles=2, dwell_end_s=0.5)),
 )
 
@@ -84,7 +88,9 @@ class CheckResult:
                 sum(c.answer != "none" for c in nones) / len(nones) if nones else 0.0
             ),
             "confusion": confusion,
-            "median_shrink": float(np.median([c.shrink for c in effects_ok])) if effects_ok else 0.0,
+            "median_shrink": float(np.median([c.shrink for c in effects_ok]))
+            if effects_ok
+            else 0.0,
             "oracle_median_shrink": (
                 float(np.median([c.oracle_shrink for c in effects_ok])) if effects_ok else 0.0
             ),
@@ -165,6 +171,8 @@ def run_check(
                     Case(truth, mass, d.effect, params, shrink, oracle_shrink, seconds)
                 )
                 mark = "ok" if d.effect == truth else "WRONG"
-                say(f"[{k}/{total}] m={mass:g} kg truth {truth}: answer {d.effect} ({mark}, "
-                    f"{seconds:.0f} s)")
+                say(
+                    f"[{k}/{total}] m={mass:g} kg truth {truth}: answer {d.effect} ({mark}, "
+                    f"{seconds:.0f} s)"
+                )
     return result

@@ -1,5 +1,6 @@
-"""The diagnosis: fit the baseline, say where the gap lies, which effect explains it, and
-how far it shrinks on held-out data.
+"""The diagnosis: where the gap lies, which effect explains it, how far it shrinks.
+
+The gap is measured on held-out data.
 
 1. Fit the baseline's stiffness, damping and friction scale (``fitting``).
 2. Attribute its residual (``where``).
@@ -20,7 +21,7 @@ import logging
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, TypedDict
 
 import numpy as np
 from numpy.typing import NDArray
@@ -65,12 +66,24 @@ PARAM_PENALTY = 0.003
 Progress = Callable[[str], None]
 
 
+class RankedEffect(TypedDict):
+    """One candidate's line in the ranking (JSON as is)."""
+
+    effect: str
+    #: Held-out gap closure after the penalty; None when the candidate was not refitted.
+    score: float | None
+    heldout_error: float | None
+    #: Share of the baseline residual the screening probe explained.
+    screening: float
+    params: dict[str, float]
+
+
 @dataclass
 class Diagnosis:
     """The answer (see to_dict for the JSON)."""
 
     effect: str
-    ranking: list[dict[str, Any]]
+    ranking: list[RankedEffect]
     where: dict[str, Any]
     gap_before: dict[str, dict[str, float]]
     gap_after: dict[str, dict[str, float]]
@@ -104,8 +117,9 @@ class Diagnosis:
         }
 
 
-def _outputs(candidate: Candidate, values: dict[str, float], traces: Sequence[Trace],
-             nominal: StandParams) -> list[Outputs]:
+def _outputs(
+    candidate: Candidate, values: dict[str, float], traces: Sequence[Trace], nominal: StandParams
+) -> list[Outputs]:
     outs = []
     for tr in traces:
         u, f = simulate_values(candidate, [values], tr, nominal)
@@ -150,8 +164,9 @@ def _stack(traces: Sequence[Trace], outs: Sequence[Outputs]) -> FloatArray:
     return np.concatenate(parts)
 
 
-def screen(traces: Sequence[Trace], nominal: StandParams, base_fit: FitResult,
-           base_out: Sequence[Outputs]) -> tuple[dict[str, float], dict[str, dict[str, float]], int]:
+def screen(
+    traces: Sequence[Trace], nominal: StandParams, base_fit: FitResult, base_out: Sequence[Outputs]
+) -> tuple[dict[str, float], dict[str, dict[str, float]], int]:
     """Score test: share of the baseline residual each effect's direction explains."""
     y_rec = _stack(traces, [Outputs(t.u_m, t.force_n) for t in traces])
     y_base = _stack(traces, base_out)
@@ -229,26 +244,46 @@ def diagnose(
         say(f"refitting {effect} (screening score {scores[effect]:.3f})")
         start = dict(probes.get(effect, base_fit.values))
         started = time.perf_counter()
-        res = fit(Candidate.build(effect), traces, nominal, baseline=start, single_start=True,
-                  max_nfev=REFIT_EVALUATIONS)
+        res = fit(
+            Candidate.build(effect),
+            traces,
+            nominal,
+            baseline=start,
+            single_start=True,
+            max_nfev=REFIT_EVALUATIONS,
+        )
         timings[f"refit {effect}"] = time.perf_counter() - started
         sims += res.evaluations
         outs = _outputs(res.candidate, res.values, traces, nominal)
         refits[effect] = (res, outs, heldout_error(traces, outs))
     timings["refits"] = time.perf_counter() - t2
 
-    ranking = []
+    ranking: list[RankedEffect] = []
     for effect in order:
         if effect in refits:
             res, _, e_aug = refits[effect]
             penalised = e_aug * (1 + PARAM_PENALTY * (len(res.candidate.params) - 3))
             # Gap closure; clipped below at −1 (far worse than the baseline is just worse).
             closure = max(-1.0, (e_base - penalised) / max(e_base - e_noise, 1e-12))
-            ranking.append({"effect": effect, "score": closure, "heldout_error": e_aug,
-                            "screening": scores[effect], "params": _effect_params(effect, res.values)})
+            ranking.append(
+                {
+                    "effect": effect,
+                    "score": closure,
+                    "heldout_error": e_aug,
+                    "screening": scores[effect],
+                    "params": _effect_params(effect, res.values),
+                }
+            )
         else:
-            ranking.append({"effect": effect, "score": None, "heldout_error": None,
-                            "screening": scores[effect], "params": {}})
+            ranking.append(
+                {
+                    "effect": effect,
+                    "score": None,
+                    "heldout_error": None,
+                    "screening": scores[effect],
+                    "params": {},
+                }
+            )
     ranking.sort(key=lambda r: (r["score"] is None, -(r["score"] or 0.0), -r["screening"]))
 
     chosen = "none"
@@ -260,11 +295,19 @@ def diagnose(
         gains = cycle_improvements(traces, base_out, outs)
         confidence = bootstrap_confidence(gains)
         relative = (e_base - e_aug) / e_base if e_base > 0 else 0.0
-        log.info("best %s: closure %.3f, relative %.3f, confidence %.3f",
-                 best["effect"], best["score"], relative, confidence)
-        if (best["score"] >= MIN_GAP_CLOSURE and relative >= MIN_RELATIVE_GAIN
-                and e_base - e_aug >= MIN_GAIN_OVER_NOISE * e_noise
-                and confidence >= MIN_CONFIDENCE):
+        log.info(
+            "best %s: closure %.3f, relative %.3f, confidence %.3f",
+            best["effect"],
+            best["score"],
+            relative,
+            confidence,
+        )
+        if (
+            best["score"] >= MIN_GAP_CLOSURE
+            and relative >= MIN_RELATIVE_GAIN
+            and e_base - e_aug >= MIN_GAIN_OVER_NOISE * e_noise
+            and confidence >= MIN_CONFIDENCE
+        ):
             chosen = best["effect"]
             after_out = outs
     e_after = heldout_error(traces, after_out)
@@ -290,4 +333,4 @@ def diagnose(
 
 def _effect_params(effect: str, values: dict[str, float]) -> dict[str, float]:
     prefix = f"{effect}."
-    return {k[len(prefix):]: v for k, v in values.items() if k.startswith(prefix)}
+    return {k[len(prefix) :]: v for k, v in values.items() if k.startswith(prefix)}

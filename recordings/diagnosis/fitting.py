@@ -24,11 +24,17 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import least_squares
 
+from recordings.diagnosis.shooting import segments_of, start_states
 from recordings.diagnosis.traces import Trace
 from sim.effects import EFFECTS, EffectSpec
 from sim.effects.measure import measure_batch_into, measurement_rows
-from sim.effects.simulator import augmented_row, simulate_augmented_rows
-from sim.model import param_vector, simulate_rows
+from sim.effects.simulator import (
+    augmented_row,
+    measure_segments,
+    simulate_augmented_rows,
+    simulate_augmented_segments,
+)
+from sim.model import param_vector, simulate_rows, simulate_segment_rows
 from sim.params import StandParams
 
 FloatArray = NDArray[np.float64]
@@ -135,6 +141,11 @@ class FitResult:
     evaluations: int
 
 
+#: Simulate by multiple shooting from measured states (``shooting``); False: open loop
+#: from rest over whole recordings (chaotic for the light weight in quick motions).
+SHOOTING = True
+
+
 def simulate_values(
     candidate: Candidate, values: Sequence[dict[str, float]], trace: Trace, nominal: StandParams
 ) -> tuple[FloatArray, FloatArray]:
@@ -142,11 +153,14 @@ def simulate_values(
 
     The baseline and measurement effects run on the fast baseline kernel (a measurement
     effect only transforms its outputs); physical effects on the augmented kernel (which
-    reproduces the baseline to 1e-9 with every effect off).
+    reproduces the baseline to 1e-9 with every effect off). With ``SHOOTING`` each trace
+    is simulated as segments restarted from measured states, assembled to full length.
     """
     x_rel = trace.x_m - trace.x_m[0]
     stands = [candidate.stand_and_effects(nominal, v, trace.mass_kg) for v in values]
     physical = candidate.effect is not None and EFFECTS[candidate.effect].kind == "physical"
+    if SHOOTING:
+        return _simulate_segments(candidate, stands, trace, x_rel, physical)
     if not physical:
         # Baseline dynamics on the fast kernel; a measurement effect only transforms them.
         rows = np.stack([param_vector(stand) for stand, _ in stands])
@@ -160,6 +174,32 @@ def simulate_values(
     rows = np.stack([augmented_row(stand, effects) for stand, effects in stands])
     res = simulate_augmented_rows(x_rel, trace.rate_hz, rows, nominal.friction)
     return res.u_m, res.force_n
+
+
+def _simulate_segments(
+    candidate: Candidate,
+    stands: Sequence[tuple[StandParams, list[EffectSpec]]],
+    trace: Trace,
+    x_rel: FloatArray,
+    physical: bool,
+) -> tuple[FloatArray, FloatArray]:
+    """``simulate_values`` by multiple shooting (see ``shooting``)."""
+    seg = segments_of(trace)
+    arows = np.stack([augmented_row(s, e) for s, e in stands])
+    init = start_states(seg, trace, arows)
+    table = stands[0][0].friction
+    if physical:
+        u, f = simulate_augmented_segments(
+            x_rel, trace.rate_hz, arows, table, seg.starts, seg.lengths, init
+        )
+    else:
+        rows = np.stack([param_vector(stand) for stand, _ in stands])
+        u, f = simulate_segment_rows(
+            x_rel, trace.rate_hz, rows, table, seg.starts, seg.lengths, init[:, :, :2]
+        )
+        if candidate.effect is not None:
+            u, f = measure_segments(u, f, trace.rate_hz, arows)
+    return seg.assemble(u), seg.assemble(f)
 
 
 class Objective:
@@ -268,9 +308,18 @@ def fit(
     if candidate.effect is None and baseline is None:
         starts = _grid_starts(objective)
     if single_start and baseline is not None:
-        starts = [np.array([p.to_internal(float(np.clip(baseline.get(p.name, 0.5 * (p.low + p.high)), p.low, p.high))) for p in candidate.params])]
-    for z0 in starts:
-        z0 = np.clip(z0, lo + 1e-9 * (hi - lo), hi - 1e-9 * (hi - lo))
+        starts = [
+            np.array(
+                [
+                    p.to_internal(
+                        float(np.clip(baseline.get(p.name, 0.5 * (p.low + p.high)), p.low, p.high))
+                    )
+                    for p in candidate.params
+                ]
+            )
+        ]
+    for start in starts:
+        z0 = np.clip(start, lo + 1e-9 * (hi - lo), hi - 1e-9 * (hi - lo))
         sol = least_squares(
             objective.residuals, z0, jac=objective.jacobian, bounds=(lo, hi),
             method="trf", x_scale="jac", max_nfev=max_nfev, xtol=1e-6, ftol=1e-8,

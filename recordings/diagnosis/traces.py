@@ -111,7 +111,7 @@ def cycle_index(x_m: FloatArray) -> IntArray:
         if x_m[i] > up and armed:
             cycle[start:i] = k
             k += 1
-            start = i
+            start = int(i)
             armed = False
         elif x_m[i] < down:
             armed = True
@@ -133,7 +133,7 @@ def _split(cycle: IntArray, n: int) -> BoolArray:
 
 def _smooth_drive(x_m: FloatArray, rate_hz: float) -> FloatArray:
     nyquist = rate_hz / 2
-    if DRIVE_FILTER_HZ >= 0.8 * nyquist or x_m.size < 30:
+    if 0.8 * nyquist <= DRIVE_FILTER_HZ or x_m.size < 30:
         return x_m
     sos = butter(4, DRIVE_FILTER_HZ / nyquist, output="sos")
     # Pad with the end values so the filter starts and ends at rest.

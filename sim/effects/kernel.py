@@ -527,3 +527,97 @@ def simulate_batch_into(x, dt, substeps, rows, knots, coef, out_u, out_v, out_t1
         simulate_into(
             xb, dt, substeps, rows[b], knots, coef, out_u[b], out_v[b], out_t1[b], out_t2[b]
         )
+
+
+# Measured start state of a segment (``simulate_segments_into``): columns of init[b, s].
+(I_U, I_V, I_F, I_HP, I_SEAT) = range(5)
+N_INIT = 5
+
+
+@njit(cache=True, error_model="numpy")
+def measured_state(c, x, xd, m):  # type: ignore[no-untyped-def]
+    """A full state from a measured start m (columns I_*) at drive x (m), rate xd (m/s).
+
+    Measured: weight u (m), v (m/s) and the drive-side force F (N). The effects' own
+    states are not measured and take quasi-static values: pulley rim where the drive-side
+    segment carries the measured F (taut) or both segments equal tension (slack), moving
+    with the fibre, bearing presliding holding the tension difference (within its limit);
+    Maxwell branches at k₂·hp, hp the elongation high-passed with τ (the branch's response
+    to the measured history, computed by the caller); string modes at their static sag
+    for the measured tension (rest sag while slack); LuGre bristle holding the measured
+    force balance n·F − m·g·sin α, limited to (and, faster than v_s, at) its sliding
+    value; pulley-jump seat m[I_SEAT] (the caller's estimate from the last taut sample).
+    Sets the discrete state in c; returns the continuous state tuple.
+    """
+    u, v, force = m[I_U], m[I_V], m[I_F]
+    n = c[P_PROJ]
+    taut = force > 0.25 * c[D_T0]
+    s, sd = 0.0, 0.0
+    if c[D_NSEG] > 1.5:
+        k1, k2 = c[D_K1], c[D_K2]
+        sd = (k1 * xd + k2 * n * v) / (k1 + k2)
+        if taut:
+            s = c[D_D10] + x - (force - c[D_C1] * (xd - sd)) / k1
+        else:
+            s = (k1 * (c[D_D10] + x) - k2 * (c[D_D20] - n * u)) / (k1 + k2)
+    a1, a2 = 0.0, 0.0
+    if c[R_TV_ON] > 0.0:
+        scale = c[D_T0] / force if taut else 1.0
+        a1, a2 = c[D_AR1] * scale, c[D_AR2] * scale
+    z = 0.0
+    if c[D_SS_ON] > 0.0:
+        r = v / c[R_SS_VS]
+        g = c[P_FRICTION_N] * _mu(abs(v), c) * (1.0 + c[R_SS_RATIO] * math.exp(-r * r))
+        limit = g / c[D_SIG0]
+        if abs(v) > c[R_SS_VS]:
+            z = limit if v > 0.0 else -limit
+        else:
+            z = min(max((n * max(force, 0.0) - c[P_GRAVITY_N]) / c[D_SIG0], -limit), limit)
+    q1, q2 = c[D_KB1] * m[I_HP], c[D_KB2] * m[I_HP]
+    y = (u, v, s, sd, q1, q2, a1, 0.0, a2, 0.0, z)
+    c[S_DEPTH] = 0.0
+    c[S_LOFF], c[S_LBASE] = m[I_SEAT], m[I_SEAT]
+    c[S_PZ], c[S_PS0] = 0.0, s
+    if c[D_NSEG] > 1.5 and c[D_SIGP] > 0.0:
+        _set_taut(c, y, x, xd)
+        t1, t2 = _tensions(c, _segments(c, y, x, 0.0, xd))
+        zmax = _bearing_limit(c, t1, t2)
+        c[S_PZ] = min(max((t1 - t2) / c[D_SIGP], -zmax), zmax)
+    return y
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def simulate_segments_into(x, dt, substeps, rows, knots, coef, starts, lens, init, out_u, out_t1):  # type: ignore[no-untyped-def]
+    """Many short runs (segments) of many rows, in parallel over (set, segment).
+
+    Segment s covers samples starts[s] … starts[s] + lens[s] − 1 of the relative drive
+    x. A segment at sample 0 starts from static rest (as ``simulate_into``); any other
+    from ``measured_state`` of init[b, s] (columns I_*). Writes u and the drive-side
+    tension into out_*[b, s, :lens[s]], the last value held to the end of the row.
+    """
+    sets = rows.shape[0]
+    segs = starts.shape[0]
+    for flat in prange(sets * segs):
+        b = flat // segs
+        s = flat % segs
+        n = lens[s]
+        xs = x[starts[s] : starts[s] + n]
+        ou = out_u[b, s]
+        ot = out_t1[b, s]
+        sv, st2 = np.empty(n), np.empty(n)
+        if starts[s] == 0:
+            simulate_into(xs, dt, substeps, rows[b], knots, coef, ou, sv, ot, st2)
+        else:
+            c = pack(rows[b], knots, coef)
+            xd = (xs[1] - xs[0]) / dt if n > 1 else 0.0
+            y = measured_state(c, xs[0], xd, init[b, s])
+            _set_taut(c, y, xs[0], xd)
+            _sample_out(c, y, xs[0], xd, 0, ou, sv, ot, st2)
+            state = np.empty(NY)
+            for k in range(NY):
+                state[k] = y[k]
+            if n > 1:
+                advance_into(xs, dt, substeps, c, state, ou, sv, ot, st2)
+        for i in range(n, ou.shape[0]):
+            ou[i] = ou[n - 1]
+            ot[i] = ot[n - 1]

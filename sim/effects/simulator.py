@@ -40,6 +40,7 @@ __all__ = [
     "simulate_augmented",
     "simulate_augmented_batch",
     "simulate_augmented_rows",
+    "simulate_augmented_segments",
 ]
 
 
@@ -198,6 +199,54 @@ def simulate_augmented_batch(
     table = next(iter(tables)) if tables else None
     rows = np.stack([augmented_row(stand, effects) for stand, effects in sets])
     return simulate_augmented_rows(rel, rate_hz, rows, table, substeps)
+
+
+def measure_segments(
+    u: FloatArray, force: FloatArray, rate_hz: float, rows: FloatArray
+) -> tuple[FloatArray, FloatArray]:
+    """Recorded u (m), F (N) of segment runs (sets, segments, samples).
+
+    Each segment's run is measured on its own: the gauge filter settles at its first
+    sample, a skewed channel is held beyond its ends.
+    """
+    sets, segs, width = u.shape
+    m = np.repeat(measure.measurement_rows(rows), segs, axis=0)
+    flat_u = np.ascontiguousarray(u.reshape(sets * segs, width))
+    flat_f = np.ascontiguousarray(force.reshape(sets * segs, width))
+    rec_u, rec_f = np.empty_like(flat_u), np.empty_like(flat_f)
+    measure.measure_batch_into(flat_u, flat_f, 1.0 / rate_hz, m, rec_u, rec_f)
+    return rec_u.reshape(u.shape), rec_f.reshape(force.shape)
+
+
+def simulate_augmented_segments(
+    x_rel_m: FloatArray,
+    rate_hz: float,
+    rows: FloatArray,
+    table: FrictionTable | None,
+    starts: NDArray[np.int64],
+    lengths: NDArray[np.int64],
+    init: FloatArray,
+    substeps: int = DEFAULT_SUBSTEPS,
+) -> tuple[FloatArray, FloatArray]:
+    """Multiple shooting: many short runs of many rows from measured states, in parallel.
+
+    ``init`` (sets, segments, ``ek.N_INIT``) holds each segment's measured start (u m,
+    v m/s, F N, high-passed elongation m; see ``ek.measured_state`` for how the effects'
+    own states are set from it); a segment starting at sample 0 starts from static rest.
+    Returns the *recorded* u (m) and F (N), shape (sets, segments, max length), each
+    segment measured on its own (``measure_segments``), last value held past its end.
+    """
+    rows2 = np.ascontiguousarray(np.atleast_2d(rows), dtype=np.float64)
+    sets, segs, width = rows2.shape[0], starts.shape[0], int(lengths.max())
+    u, t1 = np.empty((sets, segs, width)), np.empty((sets, segs, width))
+    knots, coef = friction_arrays(table)
+    ek.simulate_segments_into(
+        np.ascontiguousarray(x_rel_m, dtype=np.float64), 1.0 / rate_hz, substeps, rows2,
+        knots, coef, np.ascontiguousarray(starts, dtype=np.int64),
+        np.ascontiguousarray(lengths, dtype=np.int64),
+        np.ascontiguousarray(init, dtype=np.float64), u, t1,
+    )  # fmt: skip
+    return measure_segments(u, t1, rate_hz, rows2)
 
 
 class AugmentedStream:

@@ -59,11 +59,15 @@ def test_a_dial_gauge_gain_error_is_found_and_the_gap_shrinks(stand: StandConfig
     fitted = result.ranking[0]["params"]["gain_error"]
     assert fitted == pytest.approx(params["gain_error"], abs=0.1 * abs(params["gain_error"]) + 1e-3)
     assert result.gap_after["u"]["nrmse"] < 0.8 * result.gap_before["u"]["nrmse"]
-    assert result.gap_after["F"]["nrmse"] == pytest.approx(result.gap_before["F"]["nrmse"], rel=0.05)
+    # Segments start from the measured u, so a gain error also shows in F (the start
+    # elongation is off); explaining it must not make F worse.
+    assert result.gap_after["F"]["nrmse"] <= result.gap_before["F"]["nrmse"] * 1.05
     assert sum(result.where["channel"].values()) == pytest.approx(1.0)
 
 
-def test_where_attributes_a_residual_to_its_channel_phase_regime_and_band(stand: StandConfig) -> None:
+def test_where_attributes_a_residual_to_its_channel_phase_regime_and_band(
+    stand: StandConfig,
+) -> None:
     from recordings.diagnosis.where import SimStates, where_the_gap_lies
 
     traces, _, _ = make_campaign(stand, "none", 8.131, np.random.default_rng(1), SMALL_CAMPAIGN)
@@ -89,16 +93,23 @@ def test_stand_mismatch_alone_is_fitted_away_and_answered_none(stand: StandConfi
     assert result.heldout_error_before < 3 * result.noise_floor
 
 
-def test_diagnose_command_on_csv_recordings_with_report(tmp_path: Path, stand: StandConfig,
-                                                        capsys: pytest.CaptureFixture[str]) -> None:
-    traces, _, _ = make_campaign(stand, "dial_gauge_calibration", 8.131,
-                                 np.random.default_rng(3), SMALL_CAMPAIGN)
+def test_diagnose_command_on_csv_recordings_with_report(
+    tmp_path: Path, stand: StandConfig, capsys: pytest.CaptureFixture[str]
+) -> None:
+    traces, _, _ = make_campaign(
+        stand, "dial_gauge_calibration", 8.131, np.random.default_rng(3), SMALL_CAMPAIGN
+    )
     paths = []
     for tr in traces:
         t = np.arange(tr.samples) / tr.rate_hz
         path = tmp_path / f"{tr.name}.csv"
-        np.savetxt(path, np.column_stack([t, tr.x_m * 1e3, tr.u_m * 1e3, tr.force_n]),
-                   delimiter=",", header="t_s,x_mm,u_mm,F_N", comments="")
+        np.savetxt(
+            path,
+            np.column_stack([t, tr.x_m * 1e3, tr.u_m * 1e3, tr.force_n]),
+            delimiter=",",
+            header="t_s,x_mm,u_mm,F_N",
+            comments="",
+        )
         paths.append(str(path))
     report = tmp_path / "report"
     assert main(["diagnose", *paths, "--mass-kg", "8.131", "--json", "--report", str(report)]) == 0
@@ -113,22 +124,36 @@ def test_diagnose_command_on_csv_recordings_with_report(tmp_path: Path, stand: S
         assert (report / png).read_bytes()[:4] == b"\x89PNG"
 
 
-def test_diagnose_command_refuses_a_flat_recording(tmp_path: Path,
-                                                   capsys: pytest.CaptureFixture[str]) -> None:
+def test_diagnose_command_refuses_a_flat_recording(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     path = tmp_path / "flat.csv"
     t = np.arange(6000) / 2000.0
-    np.savetxt(path, np.column_stack([t, 0 * t, 0 * t, 40 + 0 * t]), delimiter=",",
-               header="t_s,x_mm,u_mm,F_N", comments="")
+    np.savetxt(
+        path,
+        np.column_stack([t, 0 * t, 0 * t, 40 + 0 * t]),
+        delimiter=",",
+        header="t_s,x_mm,u_mm,F_N",
+        comments="",
+    )
     assert main(["diagnose", str(path)]) == 2
     err = capsys.readouterr().err
     assert "flat.csv: the drive never moves" in err and err.count("\n") == 1
 
 
 def test_small_blind_check_scores_its_answers(stand: StandConfig) -> None:
-    result = run_check(stand, seed=11, classes=["none", "dial_gauge_calibration"],
-                       masses=[8.131], campaign=SMALL_CAMPAIGN).to_dict()
+    result = run_check(
+        stand,
+        seed=11,
+        classes=["none", "dial_gauge_calibration"],
+        masses=[8.131],
+        campaign=SMALL_CAMPAIGN,
+    ).to_dict()
     assert result["cases"] == 2
-    assert result["confusion"]["none"]["none"] + result["confusion"]["none"]["dial_gauge_calibration"] == 1
+    assert (
+        result["confusion"]["none"]["none"] + result["confusion"]["none"]["dial_gauge_calibration"]
+        == 1
+    )
     assert result["accuracy"] == 1.0
     assert result["false_alarm_rate"] == 0.0
     # The diagnosis shrinks the gap about as far as the true model does.

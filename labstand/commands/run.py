@@ -1,0 +1,348 @@
+"""``labstand run``: run a test on the stand (or the simulated stand) and record it.
+
+Pre-flight (configuration, devices, drive health, limits; refused → exit 3, nothing
+moved), a summary and — at the stand, unless ``--yes`` — a confirmation, then the run
+under ``labstand.session.Session`` with a live display. Exit codes: 0 done, 3 refused,
+4 emergency stop, 130 Ctrl-C (first: controlled stop; second: immediate disable), 1 a
+device failed before the run. Every path leaves the drive disabled and the recording
+closed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import logging
+import os
+import signal
+import sys
+import threading
+import time
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from types import FrameType
+from typing import Any
+
+from drivers.signals import SignalSpec, plan_motion
+from labstand.commands.common import add_stand_options, load_stand
+from labstand.commands.simulate import add_signal_options, signal_from_args
+from labstand.display import make_display
+from labstand.errors import CommandError, ExitCode
+from labstand.session import (
+    Outcome,
+    Preflight,
+    PreflightError,
+    RunResult,
+    Session,
+    StopRequest,
+)
+from labstand.session_devices import BACKENDS, Devices, default_backend, open_devices
+from labstand.session_record import RecordingPipe
+from labstand.session_safety import EStopError, SafetyLimits
+from recordings.base import FORMATS, open_writer
+from recordings.schema import Effect, RecordingMetadata, make_metadata
+from sim.config import StandConfig, config_from_dict
+from sim.effects import EffectSpec, parse_effects
+
+
+def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
+    """Add ``labstand run``."""
+    parser = sub.add_parser(
+        "run",
+        help="run a test on the stand (or the simulated stand) and record it",
+        description="Run a drive signal on the stand and record gauges (2 kHz), drive "
+        "states and events to -o OUT (.mcap or .h5). --backend sim starts the simulated "
+        "stand (same wire protocols) and is the default when the stand file has no "
+        "[devices] table. Ctrl-C once: controlled stop; twice: drive disabled at once.",
+    )
+    add_signal_options(parser)
+    add_stand_options(parser)
+    parser.add_argument(
+        "--backend",
+        choices=BACKENDS,
+        help="stand: the devices of the stand file's [devices]; sim: the simulated stand "
+        "(default: stand if the stand file has [devices], else sim)",
+    )
+    parser.add_argument("-o", "--output", type=Path, required=True, help="recording (.mcap, .h5)")
+    parser.add_argument("--note", default="", help="operator note, stored in the recording")
+    parser.add_argument("--yes", action="store_true", help="start without asking (stand)")
+    parser.add_argument(
+        "--reset-trip", action="store_true", help="reset a tripped drive during pre-flight"
+    )
+    parser.add_argument(
+        "--effect",
+        action="append",
+        default=[],
+        metavar="NAME",
+        help="sim: switch an unmodelled effect on in the simulated stand (repeatable)",
+    )
+    safety = parser.add_argument_group("emergency-stop thresholds (docs/acquisition.md)")
+    defaults = SafetyLimits()
+    for name, unit, what in (
+        ("position_margin_mm", "mm", "x allowed beyond the planned 0 … A"),
+        ("slack_force_n", "N", "below it the fibre counts as slack"),
+        ("slack_max_s", "s", "longest slack while the drive runs"),
+        ("gauge_timeout_s", "s", "longest gauge silence"),
+    ):
+        safety.add_argument(
+            "--" + name.replace("_", "-"),
+            type=float,
+            default=getattr(defaults, name),
+            help=f"{what}, {unit} (default {getattr(defaults, name):g})",
+        )
+    # for tests: faults injected by the simulated stand (sim/hardware/faults.py)
+    parser.add_argument("--sim-fault", action="append", default=[], help=argparse.SUPPRESS)
+    parser.set_defaults(func=run)
+
+
+def config_with_mass(config: StandConfig, mass_kg: float) -> dict[str, Any]:
+    """The stand configuration whose default weight is the mass on the stand."""
+    raw = config.to_dict()
+    weights = raw["weights_kg"]
+    name = next((n for n, m in weights.items() if m == mass_kg), None)
+    if name is None:
+        name = next(
+            f"run{i or ''}" for i in range(len(weights) + 1) if f"run{i or ''}" not in weights
+        )
+        weights[name] = mass_kg
+    raw["weight"]["default"] = name
+    config_from_dict(raw, config.source)  # still valid
+    return raw
+
+
+def _title(args: argparse.Namespace, spec: SignalSpec, mass_kg: float) -> str:
+    what = f"situation {args.situation}: " if args.situation else ""
+    return (
+        f"{what}{spec.shape} A = {spec.amplitude_m * 1e3:g} mm, f = {spec.frequency_hz:g} Hz, "
+        f"{spec.cycles} cycle(s), m = {mass_kg:g} kg"
+    )
+
+
+def _effects(args: argparse.Namespace, backend: str) -> list[EffectSpec]:
+    effects = parse_effects(args.effect)
+    if effects and backend != "sim":
+        raise CommandError("--effect needs --backend sim", ExitCode.USAGE)
+    for spec in effects:
+        if spec.params:
+            raise CommandError(
+                f"--effect {spec}: the simulated stand runs effects at their default "
+                "parameters only; give the name alone",
+                ExitCode.USAGE,
+            )
+    return effects
+
+
+@dataclass(frozen=True)
+class _Plan:
+    """What the arguments ask for, checked before any device is opened."""
+
+    config: StandConfig
+    spec: SignalSpec
+    mass_kg: float
+    backend: str
+    effects: list[EffectSpec]
+    safety: SafetyLimits
+    confirm: bool
+
+
+def _check(args: argparse.Namespace) -> _Plan:
+    """Every check that needs no device: usage (2) and refusals (3)."""
+    config = load_stand(args)
+    spec, mass = signal_from_args(args, config)
+    backend = args.backend or default_backend(config)
+    if backend == "stand" and config.devices is None:
+        raise CommandError(
+            f"{config.source}: no [devices] table, so no stand to run; add one "
+            "(docs/configuration.md) or use --backend sim",
+            ExitCode.USAGE,
+        )
+    effects = _effects(args, backend)
+    safety = SafetyLimits(
+        position_margin_mm=args.position_margin_mm,
+        slack_force_n=args.slack_force_n,
+        slack_max_s=args.slack_max_s,
+        gauge_timeout_s=args.gauge_timeout_s,
+    )
+    plan_motion(spec, config.drive)  # LimitError: refused before anything is touched
+    suffix = args.output.suffix.lower()
+    if suffix not in FORMATS or FORMATS[suffix][1] is None:
+        writable = sorted(s for s, f in FORMATS.items() if f[1] is not None)
+        raise CommandError(
+            f"{args.output}: cannot record {suffix or 'without a suffix'!r}; use one of "
+            f"{', '.join(writable)}",
+            ExitCode.USAGE,
+        )
+    if not args.output.parent.is_dir():
+        raise CommandError(f"{args.output.parent}: no such directory", ExitCode.USAGE)
+    confirm = backend == "stand" and not args.yes
+    if confirm and not sys.stdin.isatty():
+        raise CommandError(
+            "at the stand a run must be confirmed, and there is no terminal to ask on: give --yes",
+            ExitCode.REFUSED,
+        )
+    return _Plan(config, spec, mass, backend, effects, safety, confirm)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Check, confirm, run, report."""
+    if not args.verbose:  # its time-outs are reported by the drive driver, once
+        logging.getLogger("pymodbus").setLevel(logging.CRITICAL)
+    plan = _check(args)
+    devices = open_devices(
+        plan.backend,
+        plan.config,
+        mass_kg=plan.mass_kg,
+        stand_file=args.stand,
+        effects=tuple(e.name for e in plan.effects),
+        sim_args=tuple(a for f in args.sim_fault for a in ("--fault", f)),
+    )
+    try:
+        title = _title(args, plan.spec, plan.mass_kg)
+        _say(f"labstand run: {title}")
+        _say(f"  {plan.backend}: {devices.where}")
+        session = Session(devices.drive, devices.gauges, plan.safety, make_display(sys.stdout))
+        try:
+            result = _session(session, devices, plan, args, title)
+        finally:
+            session.shutdown()
+    finally:
+        devices.close()
+    return _report(result, args.output, devices.sim_summary)
+
+
+def _session(
+    session: Session, devices: Devices, plan: _Plan, args: argparse.Namespace, title: str
+) -> RunResult:
+    """Pre-flight, summary, confirmation, prepare, then the recorded run."""
+    try:
+        pre = session.preflight(plan.spec, args.reset_trip)
+    except PreflightError as err:
+        code = ExitCode.REFUSED if err.refused else ExitCode.FAILURE
+        raise CommandError(f"pre-flight: {err}", code) from err
+    _summary(session, pre, args.output)
+    if plan.confirm:
+        with session.keepalive():
+            _confirm()
+    stop = StopRequest()
+    with _stop_signals(stop):
+        try:
+            session.prepare(pre, stop)
+        except EStopError as err:
+            session.shutdown()
+            code = ExitCode.INTERRUPTED if stop.presses else ExitCode.ESTOP
+            drive = "drive disabled" if session.drive_disabled else "the drive did not answer"
+            raise CommandError(f"{err}; {drive}; nothing recorded", code) from err
+        metadata = make_metadata(
+            config_with_mass(plan.config, plan.mass_kg),
+            devices.backend,
+            sample_rate_hz=plan.config.sample_rate_hz,
+            signal={**plan.spec.to_dict(), "situation": args.situation},
+            effects=tuple(Effect(e.name, e.resolved()) for e in plan.effects),
+            operator_note=args.note,
+        )
+        return _record(session, devices, metadata, args, stop, title)
+
+
+def _record(
+    session: Session,
+    devices: Devices,
+    metadata: RecordingMetadata,
+    args: argparse.Namespace,
+    stop: StopRequest,
+    title: str,
+) -> RunResult:
+    """The run itself, recording into the output; the file is closed on every path."""
+    pipe = RecordingPipe(open_writer(args.output, metadata))
+    try:
+        if args.note:
+            pipe.put_event(0, "note", args.note)
+        with session.display:
+            return session.run(pipe, stop, title)
+    finally:
+        try:
+            session.shutdown()
+            final = devices.stop_sim()
+            if final:
+                state = "enabled" if final.get("enabled") else "disabled"
+                pipe.put_event(
+                    session.clock.host_ns(time.monotonic()),
+                    "note",
+                    f"simulated stand stopped: drive {state}, "
+                    f"x = {final.get('x_mm', float('nan')):.2f} mm, trips {final.get('trips')}",
+                )
+        finally:
+            pipe.close()
+
+
+def _say(text: str) -> None:
+    print(text, flush=True)
+
+
+def _summary(session: Session, pre: Preflight, output: Path) -> None:
+    st, limits, p = pre.state, session.drive.limits, pre.profile
+    _say(
+        f"  drive: healthy, x = {st.position_m * 1e3:.2f} mm"
+        + (" (moves home first)" if pre.needs_home else "")
+        + f"; gauges: F = {pre.force_n:.1f} N, u = {pre.u_mm:.2f} mm at rest"
+    )
+    _say(
+        f"  motion: {p.duration_s:.2f} s, peak {p.peak_speed_m_s:.3g} m/s, "
+        f"{p.peak_accel_m_s2:.3g} m/s² (drive limits {limits.speed_max_m_s:g} m/s, "
+        f"{limits.accel_max_m_s2:g} m/s²)"
+    )
+    _say(f"  safety: {session.monitor.describe()}")
+    _say(f"  recording: {output}")
+
+
+def _confirm() -> None:
+    answer = input("Start the run? The drive will move. [y/N] ").strip().lower()
+    if answer not in {"y", "yes"}:
+        raise CommandError("not confirmed; nothing moved", ExitCode.REFUSED)
+
+
+@contextlib.contextmanager
+def _stop_signals(stop: StopRequest) -> Iterator[None]:
+    """Ctrl-C (and SIGTERM) count presses instead of raising, while the drive may move."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def handler(signum: int, frame: FrameType | None) -> None:
+        stop.press()
+        text = (
+            "\nlabstand: stopping in order (Ctrl-C again: disable the drive at once)\n"
+            if stop.presses == 1
+            else "\nlabstand: disabling the drive at once\n"
+        )
+        with contextlib.suppress(OSError):
+            os.write(sys.stderr.fileno(), text.encode())
+
+    old = {sig: signal.signal(sig, handler) for sig in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        yield
+    finally:
+        for sig, previous in old.items():
+            signal.signal(sig, previous)
+
+
+def _report(result: RunResult, output: Path, sim: dict[str, Any]) -> int:
+    stats = result.stats
+    where = (
+        f"recording {output} closed ({result.elapsed_s:.2f} s, {result.samples} samples, "
+        f"{stats.lost} lost, {stats.corrupt} corrupt)"
+    )
+    if result.drive_disabled:
+        drive = "drive disabled"
+    else:
+        drive = "the drive did not acknowledge the disable"
+        if sim:
+            state = "disabled" if not sim.get("enabled") else "STILL ENABLED"
+            drive += f"; the simulated drive reports itself {state}, trips {sim.get('trips')}"
+        else:
+            drive += "; its watchdog stops it within 1 s"
+    if result.outcome is Outcome.DONE:
+        _say(f"Done: {drive}; {where}")
+        return ExitCode.OK
+    code = ExitCode.INTERRUPTED if result.outcome is Outcome.STOPPED else ExitCode.ESTOP
+    raise CommandError(f"{result.reason}; {drive}; {where}", code)

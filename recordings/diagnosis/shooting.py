@@ -1,0 +1,222 @@
+"""Multiple shooting from measured states: short simulations that restart on the data.
+
+With the light weight in quick motions the weight bounces on a slack fibre and the model
+is chaotic (``sim.sensitivity``): an open-loop run from rest drifts away from any
+recording after a few bounces whatever the parameters, so output error over a whole
+recording measures chaos, not the model. Here every trace is cut into *segments*; each
+is simulated from the state *measured* at its start, so a prediction error can grow for
+at most one segment and the fit compares the model's short-term dynamics with the data.
+
+* Segment bodies are ``SEGMENT_S`` long. Each boundary is moved (by up to a quarter of a
+  segment) to where the measured force changes least, so no segment starts in a snatch,
+  where a local fit of the state would be biased.
+* Each segment after the first starts ``WARMUP_S`` before its body: the warm-up lets the
+  effects' unmeasured states and the gauge filter settle, gives a skewed channel its
+  history, and is not scored (the previous segment's body covers those samples).
+* The start state: u and v from a local cubic least-squares (Savitzky–Golay) fit of the
+  recorded u over ±``STATE_HALF_WIDTH_S``; F likewise smoothed. A candidate's measurement
+  effect is inverted first (the dial gauge's gain and offset, the displacement channel's
+  skew), so the state is the true one the candidate implies. The effects' own states are
+  set by ``sim.effects.kernel.measured_state``: quasi-static values, and for the Maxwell
+  branch its response to the measured elongation history.
+* The first segment starts at sample 0 from static rest, exactly as an open-loop run.
+
+Held-out cycles are then judged on segment predictions as well; that is fair because
+every start state comes from measurements, never from a fitted trajectory.
+"""
+
+from __future__ import annotations
+
+import weakref
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.signal import lfilter, savgol_filter
+
+from recordings.diagnosis.traces import Trace
+from sim.effects import kernel as ek
+
+FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.int64]
+
+#: Segment body length, s (see the module docstring; chosen by measurement, see tests).
+SEGMENT_S = 0.25
+#: Unscored lead-in of every segment after the first, s.
+WARMUP_S = 0.025
+#: Half width of the local cubic fit that estimates u and v at a segment start, s.
+STATE_HALF_WIDTH_S = 0.005
+#: Smoothing of |dF/dt| when choosing boundaries, s.
+CALM_WINDOW_S = 0.02
+
+
+@dataclass(frozen=True)
+class Segments:
+    """How one trace is cut, and its measured states at the segment starts.
+
+    Attributes
+    ----------
+    starts, lengths
+        First simulated sample and number of simulated samples per segment.
+    body
+        First scored sample per segment (bodies tile the trace: body[k + 1] ends k).
+    u_m, v_m_s, force_n
+        Smoothed recorded u, its rate and F at every sample (state estimates).
+    seg_of, offset
+        For every sample of the trace: its segment and index inside that segment's run.
+    """
+
+    starts: IntArray
+    lengths: IntArray
+    body: IntArray
+    u_m: FloatArray
+    v_m_s: FloatArray
+    force_n: FloatArray
+    seg_of: IntArray
+    offset: IntArray
+
+    @property
+    def count(self) -> int:
+        """Number of segments."""
+        return int(self.starts.size)
+
+    def assemble(self, runs: FloatArray) -> FloatArray:
+        """Segment runs (sets, segments, samples) → one series per set (sets, N)."""
+        return np.asarray(runs[:, self.seg_of, self.offset])
+
+
+def _filled(series: FloatArray) -> FloatArray:
+    """Lost samples (NaN) linearly interpolated, so smoothing can run over them."""
+    ok = np.isfinite(series)
+    if ok.all():
+        return series
+    idx = np.arange(series.size)
+    return np.interp(idx, idx[ok], series[ok])
+
+
+def _boundaries(force: FloatArray, rate_hz: float, segment_s: float) -> IntArray:
+    """Body starts: every ``segment_s``, each moved to the calmest nearby force sample."""
+    n = force.size
+    step = max(round(segment_s * rate_hz), 4)
+    if n < 2 * step:
+        return np.array([0], dtype=np.int64)
+    width = max(1, int(CALM_WINDOW_S * rate_hz))
+    rough = np.convolve(np.abs(np.gradient(force)), np.ones(width) / width, mode="same")
+    # Prefer a taut fibre: slack hides the effects' states (string sag, pulley seat).
+    rough = rough + np.where(force > 0.5 * np.median(force), 0.0, np.abs(rough).max())
+    reach = step // 4
+    bounds = [0]
+    for nominal in range(step, n - step // 2, step):
+        lo, hi = max(nominal - reach, bounds[-1] + step // 2), min(nominal + reach, n - step // 2)
+        if hi <= lo:
+            continue
+        bounds.append(lo + int(np.argmin(rough[lo:hi])))
+    return np.asarray(bounds, dtype=np.int64)
+
+
+def segment_trace(
+    trace: Trace,
+    segment_s: float = SEGMENT_S,
+    warmup_s: float = WARMUP_S,
+    half_width_s: float = STATE_HALF_WIDTH_S,
+) -> Segments:
+    """Cut a trace into segments and estimate the measured state along it."""
+    rate = trace.rate_hz
+    u = _filled(trace.u_m)
+    f = _filled(trace.force_n)
+    half = max(2, round(half_width_s * rate))
+    window = 2 * half + 1
+    order = 3 if window > 4 else window - 1
+    u_s = savgol_filter(u, window, order, mode="interp")
+    v_s = savgol_filter(u, window, order, deriv=1, delta=1.0 / rate, mode="interp")
+    f_s = savgol_filter(f, window, order, mode="interp")
+    body = _boundaries(f_s, rate, segment_s)
+    warm = round(warmup_s * rate)
+    starts = np.where(body > 0, np.maximum(body - warm, 0), 0).astype(np.int64)
+    ends = np.append(body[1:], trace.samples)
+    lengths = (ends - starts).astype(np.int64)
+    seg_of = np.repeat(np.arange(body.size), ends - body).astype(np.int64)
+    offset = (np.arange(trace.samples) - starts[seg_of]).astype(np.int64)
+    return Segments(starts, lengths, body, u_s, v_s, f_s, seg_of, offset)
+
+
+_CACHE: dict[int, tuple[weakref.ref[Trace], Segments]] = {}
+
+
+def segments_of(trace: Trace) -> Segments:
+    """``segment_trace`` with the default settings, memoised per trace object."""
+    hit = _CACHE.get(id(trace))
+    if hit is not None and hit[0]() is trace:
+        return hit[1]
+    seg = segment_trace(trace)
+    for key in [k for k, (ref, _) in _CACHE.items() if ref() is None]:
+        del _CACHE[key]
+    _CACHE[id(trace)] = (weakref.ref(trace), seg)
+    return seg
+
+
+def start_states(seg: Segments, trace: Trace, rows: FloatArray) -> FloatArray:
+    """Measured start states (sets, segments, ek.N_INIT) for augmented kernel rows.
+
+    A row's measurement effects are inverted: the dial gauge reads (1 + g)·u + offset,
+    so u = (u_rec − offset)/(1 + g); a displacement channel recorded Δt late shows the
+    true u of Δt earlier, so the true u now is u_rec(t + Δt) ≈ u_rec + Δt·v.
+    """
+    rows2 = np.atleast_2d(rows)
+    idx = seg.starts
+    u = np.broadcast_to(seg.u_m[idx], (rows2.shape[0], idx.size)).copy()
+    v = np.broadcast_to(seg.v_m_s[idx], u.shape).copy()
+    skew = np.where(rows2[:, ek.R_CS_ON] > 0, rows2[:, ek.R_CS_DISP], 0.0)[:, None]
+    u = u + skew * v
+    dial = rows2[:, ek.R_DG_ON] > 0
+    gain = np.where(dial, 1.0 + rows2[:, ek.R_DG_GAIN], 1.0)[:, None]
+    offset = np.where(dial, rows2[:, ek.R_DG_OFFSET], 0.0)[:, None]
+    u = (u - offset) / gain
+    v = v / gain
+    init = np.zeros((rows2.shape[0], idx.size, ek.N_INIT))
+    init[:, :, ek.I_U] = u
+    init[:, :, ek.I_V] = v
+    init[:, :, ek.I_F] = seg.force_n[idx]
+    for b, row in enumerate(rows2):
+        if row[ek.R_VE_ON] > 0:
+            init[b, :, ek.I_HP] = _branch_elongation(seg, trace, row)[idx]
+        if row[ek.R_PJ_ON] > 0:
+            init[b, :, ek.I_SEAT] = _seat(seg, trace, row)[idx]
+    return init
+
+
+def _seat(seg: Segments, trace: Trace, row: FloatArray) -> FloatArray:
+    """The pulley-jump seat offset (m) along the trace, from the last taut sample.
+
+    While taut the measured force fixes the elongation, so the seat is what the
+    elongation computed from the measured x and u lacks, (F − F_home)/k, rounded to the
+    nearer of the two seats 0 and step_m. While slack: the seat of the last taut sample.
+    """
+    k, damp, n = row[ek.P_STIFF], row[ek.P_DAMP], row[ek.P_PROJ]
+    x = trace.x_m - trace.x_m[0]
+    xd = np.gradient(x, 1.0 / trace.rate_hz)
+    home = k * (row[ek.P_PRELOAD] + x - n * seg.u_m) + damp * (xd - n * seg.v_m_s)
+    step = row[ek.R_PJ_STEP]
+    # Only the two seats: a continuous estimate would let the seat soak up any elongation
+    # mismatch (a gauge gain error, say) at every segment start.
+    est = np.where(np.abs((seg.force_n - home) / k - step) < 0.5 * abs(step), step, 0.0)
+    taut = seg.force_n > 0.25 * row[ek.P_GRAVITY_N] / n
+    last = np.maximum.accumulate(np.where(taut, np.arange(taut.size), 0))
+    out: FloatArray = np.where(taut[last], est[last], 0.0)
+    return out
+
+
+def _branch_elongation(seg: Segments, trace: Trace, row: FloatArray) -> FloatArray:
+    """The Maxwell branch's elongation q/k₂ along the trace, from the measured history.
+
+    q̇ = k₂·δ̇ − q/τ while taut and q̇ = −q/τ while slack: q/k₂ is the elongation
+    max(δ, 0) high-passed with time constant τ (first order, discretised exactly for a
+    step input).
+    """
+    x = trace.x_m - trace.x_m[0]
+    delta = np.maximum(row[ek.P_PRELOAD] + x - row[ek.P_PROJ] * seg.u_m, 0.0)
+    a = float(np.exp(-1.0 / (trace.rate_hz * row[ek.R_VE_TAU])))
+    # y_k = a·y_{k−1} + (δ_k − δ_{k−1}), from rest (y = 0 at the start).
+    d = np.diff(delta, prepend=delta[0])
+    out: FloatArray = lfilter([1.0], [1.0, -a], d)
+    return out

@@ -1,0 +1,142 @@
+"""Multiple shooting from measured states: segmentation, state estimation, exact restarts."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from drivers.signals import Shape, SignalSpec, plan_motion
+from recordings.diagnosis.fitting import Candidate, simulate_values
+from recordings.diagnosis.shooting import segment_trace, start_states
+from recordings.diagnosis.traces import Trace, make_trace
+from sim import kernel
+from sim.config import StandConfig, default_config
+from sim.effects import EffectSpec, simulate_augmented
+from sim.effects import kernel as ek
+from sim.effects.simulator import augmented_row, simulate_augmented_segments
+from sim.model import friction_arrays, param_vector, simulate, simulate_segment_rows
+
+QUICK = SignalSpec(Shape.TRAPEZOIDAL, 0.025, 2.0, cycles=3, ramp_fraction=0.4)
+BASE = {"stiffness_scale": 1.0, "damping_scale": 1.0, "friction_scale": 1.0}
+
+
+@pytest.fixture(scope="module")
+def stand() -> StandConfig:
+    return default_config()
+
+
+def _trace(
+    stand: StandConfig, mass: float, effects: list[EffectSpec], noise_u: float = 0.0, seed: int = 0
+) -> tuple[Trace, np.ndarray]:
+    t, x = plan_motion(QUICK, stand.drive).sample(stand.sample_rate_hz)
+    run = simulate_augmented(x, stand.sample_rate_hz, stand.stand_params("final", mass), effects)
+    u = run.u_m + np.random.default_rng(seed).normal(0.0, noise_u, x.size)
+    frame = pd.DataFrame(
+        {"x_mm": x * 1e3, "u_mm": u * 1e3, "F_N": run.force_n}, index=pd.Index(t, name="t_s")
+    )
+    return make_trace("quick", frame, mass), run.v_m_s
+
+
+def test_segments_tile_the_trace_and_start_calm(stand: StandConfig) -> None:
+    tr, _ = _trace(stand, 3.096, [])
+    seg = segment_trace(tr)
+    assert seg.body[0] == 0 and seg.starts[0] == 0
+    assert np.all(np.diff(seg.body) > 0)
+    # Every sample belongs to exactly one body, and its run covers it.
+    assert seg.seg_of.size == tr.samples
+    assert np.all(seg.offset >= 0) and np.all(seg.offset < seg.lengths[seg.seg_of])
+    # Later segments start with a warm-up before their body, mostly on a taut fibre.
+    assert np.all(seg.starts[1:] < seg.body[1:])
+    assert np.mean(tr.force_n[seg.starts[1:]] > 0.0) > 0.7
+
+
+def test_a_segment_from_the_true_state_reproduces_the_open_loop_run(stand: StandConfig) -> None:
+    params = stand.stand_params("final", 3.096)
+    _, x = plan_motion(QUICK, stand.drive).sample(stand.sample_rate_hz)
+    run = simulate(x, stand.sample_rate_hz, params)
+    rel = x - x[0]
+    starts = np.array([0, 700, 1500], dtype=np.int64)
+    lengths = np.array([700, 900, 600], dtype=np.int64)
+    init = np.stack([np.array([[0.0, 0.0]] + [[run.u_m[s], run.v_m_s[s]] for s in starts[1:]])])
+    row = param_vector(params)[None, :]
+    u, f = simulate_segment_rows(
+        rel, stand.sample_rate_hz, row, params.friction, starts, lengths, init
+    )
+    for k, (s, n) in enumerate(zip(starts, lengths, strict=True)):
+        np.testing.assert_allclose(u[0, k, :n], run.u_m[s : s + n], atol=1e-9)
+        np.testing.assert_allclose(f[0, k, :n], run.force_n[s : s + n], atol=1e-4)
+    # The augmented kernel with every effect off restarts the same way.
+    arow = augmented_row(params)[None, :]
+    ainit = np.zeros((1, starts.size, ek.N_INIT))
+    ainit[0, :, :2] = init[0]
+    ainit[0, :, ek.I_F] = run.force_n[starts]
+    ua, fa = simulate_augmented_segments(
+        rel, stand.sample_rate_hz, arow, params.friction, starts, lengths, ainit
+    )
+    np.testing.assert_allclose(ua, u, atol=1e-9)
+    np.testing.assert_allclose(fa, f, atol=1e-6)
+
+
+def test_kernel_segment_zero_is_the_open_loop_run(stand: StandConfig) -> None:
+    params = stand.stand_params("final", 8.131)
+    _, x = plan_motion(QUICK, stand.drive).sample(stand.sample_rate_hz)
+    rel = x - x[0]
+    knots, coef = friction_arrays(params.friction)
+    n = rel.size
+    u, v, f = np.empty(n), np.empty(n), np.empty(n)
+    kernel.simulate_into(
+        rel, 1.0 / stand.sample_rate_hz, 1, param_vector(params), knots, coef, u, v, f
+    )
+    su, sf = simulate_segment_rows(
+        rel,
+        stand.sample_rate_hz,
+        param_vector(params)[None, :],
+        params.friction,
+        np.array([0]),
+        np.array([n]),
+        np.zeros((1, 1, 2)),
+    )
+    np.testing.assert_array_equal(su[0, 0], u)
+    np.testing.assert_array_equal(sf[0, 0], f)
+
+
+def test_state_estimation_error_is_bounded_under_noise(stand: StandConfig) -> None:
+    noise = 5e-6
+    tr, v_true = _trace(stand, 8.131, [], noise_u=noise, seed=3)
+    clean, _ = _trace(stand, 8.131, [])
+    seg = segment_trace(tr)
+    idx = seg.starts[1:]
+    du = seg.u_m[idx] - clean.u_m[idx]
+    dv = seg.v_m_s[idx] - v_true[idx]
+    assert np.sqrt(np.mean(du**2)) < 0.8 * noise  # smoothing beats the raw sample
+    # A cubic fit over ±5 ms: σ_v ≈ σ_u·√(75/(N³·dt²))… well under 5 mm/s here.
+    assert np.sqrt(np.mean(dv**2)) < 5e-3
+
+
+def test_a_dial_gauge_candidate_starts_from_the_true_displacement(stand: StandConfig) -> None:
+    tr, _ = _trace(stand, 8.131, [EffectSpec("dial_gauge_calibration", {"gain_error": 0.03})])
+    seg = segment_trace(tr)
+    cand = Candidate.build("dial_gauge_calibration")
+    values = dict(
+        BASE, **{"dial_gauge_calibration.gain_error": 0.03, "dial_gauge_calibration.offset_m": 0.0}
+    )
+    stand_p, effects = cand.stand_and_effects(stand.stand_params("final", 8.131), values, 8.131)
+    init = start_states(seg, tr, augmented_row(stand_p, effects)[None, :])
+    np.testing.assert_allclose(init[0, :, ek.I_U], seg.u_m[seg.starts] / 1.03)
+    # And the candidate then predicts the recording to noise level, the baseline does not.
+    nominal = stand.stand_params("final", 8.131)
+    _, f = simulate_values(cand, [values], tr, nominal)
+    _, fb = simulate_values(Candidate.build(None), [BASE], tr, nominal)
+    spread = np.ptp(tr.force_n)
+    assert np.max(np.abs(f[0] - tr.force_n)) < 0.05 * spread
+    assert np.max(np.abs(fb[0] - tr.force_n)) > 0.15 * spread
+
+
+def test_shooting_tames_the_light_weights_chaos(stand: StandConfig) -> None:
+    # A 1e-6 stiffness change barely moves segment predictions (open loop: chaotic).
+    tr, _ = _trace(stand, 3.096, [])
+    nominal = stand.stand_params("final", 3.096)
+    sets = [BASE, dict(BASE, stiffness_scale=1.0 + 1e-6)]
+    u, _ = simulate_values(Candidate.build(None), sets, tr, nominal)
+    assert np.max(np.abs(u[0] - u[1])) < 1e-7
