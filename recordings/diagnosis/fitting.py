@@ -286,6 +286,54 @@ def _grid_starts(objective: Objective) -> list[FloatArray]:
     return [grid[i] for i in np.argsort(costs)[:GRID_STARTS]]
 
 
+#: Levels per parameter of an effect's start grid, by its number of fitted parameters
+#: (at most ≈ 27 points: one batch).
+EFFECT_GRID_LEVELS = {1: 8, 2: 5, 3: 3}
+
+
+def effect_grid_start(
+    candidate: Candidate,
+    traces: Sequence[Trace],
+    nominal: StandParams,
+    baseline: dict[str, float],
+    extra: Sequence[dict[str, float]] = (),
+    stride: int = 4,
+) -> dict[str, float]:
+    """The best start for an effect's refit: a coarse grid over its own parameters.
+
+    The baseline's parameters stay at their fit; the effect's take interior levels of
+    their plausible ranges (log-spaced where they span decades), all in one batch, with
+    ``extra`` (e.g. the screening's best probe) as further points. The effects' output
+    error is rugged (a ringing span's damping ratio: a factor 2 off triples the cost), so
+    a local fit needs a start in the right basin.
+    """
+    objective = Objective(candidate, traces, nominal, stride)
+    own = [p for p in candidate.params if p.name not in baseline]
+    levels = EFFECT_GRID_LEVELS.get(len(own), 2)
+    axes = []
+    for p in own:
+        lo, hi = p.bounds()
+        axes.append(np.linspace(lo, hi, levels + 2)[1:-1])
+    base = {p.name: p.to_internal(baseline[p.name]) for p in candidate.params if p.name in baseline}
+    points = []
+    for combo in np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, len(own)):
+        z = dict(base)
+        z.update({p.name: float(v) for p, v in zip(own, combo, strict=True)})
+        points.append(np.array([z[p.name] for p in candidate.params]))
+    for values in extra:
+        merged = {**baseline, **values}
+        points.append(
+            np.array(
+                [
+                    p.to_internal(float(np.clip(merged[p.name], p.low, p.high)))
+                    for p in candidate.params
+                ]
+            )
+        )
+    costs = np.sum(objective.residuals_batch(np.stack(points)) ** 2, axis=1)
+    return candidate.natural(points[int(np.argmin(costs))])
+
+
 def fit(
     candidate: Candidate,
     traces: Sequence[Trace],

@@ -544,7 +544,8 @@ def measured_state(c, x, xd, m):  # type: ignore[no-untyped-def]
     with the fibre, bearing presliding holding the tension difference (within its limit);
     Maxwell branches at k₂·hp, hp the elongation high-passed with τ (the branch's response
     to the measured history, computed by the caller); string modes at their static sag
-    for the measured tension (rest sag while slack); LuGre bristle holding the measured
+    for the measured tension (rest sag while slack; ``simulate_chained_into`` replaces
+    them by the previous segment's); LuGre bristle holding the measured
     force balance n·F − m·g·sin α, limited to (and, faster than v_s, at) its sliding
     value; pulley-jump seat m[I_SEAT] (the caller's estimate from the last taut sample).
     Sets the discrete state in c; returns the continuous state tuple.
@@ -584,6 +585,63 @@ def measured_state(c, x, xd, m):  # type: ignore[no-untyped-def]
         zmax = _bearing_limit(c, t1, t2)
         c[S_PZ] = min(max((t1 - t2) / c[D_SIGP], -zmax), zmax)
     return y
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def simulate_chained_into(x, dt, substeps, rows, knots, coef, starts, lens, init, out_u, out_t1):  # type: ignore[no-untyped-def]
+    """``simulate_segments_into`` segment after segment per row (parallel over rows only).
+
+    The string modes and the LuGre bristle are not observable from the gauges at a start
+    (a ringing span's phase; the bristle's pre-sliding while sticking), but they are stable
+    and driven by the tension and the weight's motion: simulating them is their observer.
+    So every segment after the first starts them where the previous segment's run had
+    them at that sample; everything else starts from ``measured_state`` as before.
+    """
+    sets = rows.shape[0]
+    segs = starts.shape[0]
+    for b in prange(sets):
+        carried = np.zeros(NY - Y_A1)
+        have = False
+        for s in range(segs):
+            n = lens[s]
+            xs = x[starts[s] : starts[s] + n]
+            ou, ot = out_u[b, s], out_t1[b, s]
+            sv, st2 = np.empty(n), np.empty(n)
+            c = pack(rows[b], knots, coef)
+            xd = (xs[1] - xs[0]) / dt if n > 1 else 0.0
+            if starts[s] == 0:
+                y = rest_state(c)
+                ou[0], sv[0] = y[Y_U], y[Y_V]
+                ot[0] = c[D_K1] * (c[D_D10] + xs[0])
+                st2[0] = ot[0]
+            else:
+                y = measured_state(c, xs[0], xd, init[b, s])
+                if have:
+                    y = (
+                        y[0], y[1], y[2], y[3], y[4], y[5],
+                        carried[0], carried[1], carried[2], carried[3], carried[4],
+                    )  # fmt: skip
+                _set_taut(c, y, xs[0], xd)
+                _sample_out(c, y, xs[0], xd, 0, ou, sv, ot, st2)
+            state = np.empty(NY)
+            for k in range(NY):
+                state[k] = y[k]
+            hand = starts[s + 1] - starts[s] if s + 1 < segs else n
+            if 0 < hand < n:
+                h1 = hand + 1
+                advance_into(xs[:h1], dt, substeps, c, state, ou[:h1], sv[:h1], ot[:h1], st2[:h1])
+                for k in range(NY - Y_A1):
+                    carried[k] = state[Y_A1 + k]
+                have = True
+                tail = slice(hand, n)
+                advance_into(
+                    xs[tail], dt, substeps, c, state, ou[tail], sv[tail], ot[tail], st2[tail]
+                )
+            elif n > 1:
+                advance_into(xs, dt, substeps, c, state, ou, sv, ot, st2)
+            for i in range(n, ou.shape[0]):
+                ou[i] = ou[n - 1]
+                ot[i] = ot[n - 1]
 
 
 @njit(cache=True, parallel=True, error_model="numpy")

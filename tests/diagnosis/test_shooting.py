@@ -130,7 +130,7 @@ def test_a_dial_gauge_candidate_starts_from_the_true_displacement(stand: StandCo
     _, fb = simulate_values(Candidate.build(None), [BASE], tr, nominal)
     spread = np.ptp(tr.force_n)
     assert np.max(np.abs(f[0] - tr.force_n)) < 0.05 * spread
-    assert np.max(np.abs(fb[0] - tr.force_n)) > 0.15 * spread
+    assert np.max(np.abs(fb[0] - tr.force_n)) > 0.1 * spread
 
 
 def test_shooting_tames_the_light_weights_chaos(stand: StandConfig) -> None:
@@ -140,3 +140,72 @@ def test_shooting_tames_the_light_weights_chaos(stand: StandConfig) -> None:
     sets = [BASE, dict(BASE, stiffness_scale=1.0 + 1e-6)]
     u, _ = simulate_values(Candidate.build(None), sets, tr, nominal)
     assert np.max(np.abs(u[0] - u[1])) < 1e-7
+
+
+def test_restarts_only_after_slack(stand: StandConfig) -> None:
+    # Taut all through (heavy weight, slow quasi-sine): one open-loop run, no restarts.
+    slow = SignalSpec(Shape.QUASI_SINUSOIDAL, 0.060, 0.5, cycles=2)
+    t, x = plan_motion(slow, stand.drive).sample(stand.sample_rate_hz)
+    run = simulate(x, stand.sample_rate_hz, stand.stand_params("final", 8.131))
+    assert run.force_n.min() > 0.5 * run.preload_tension_n
+    frame = pd.DataFrame(
+        {"x_mm": x * 1e3, "u_mm": run.u_m * 1e3, "F_N": run.force_n},
+        index=pd.Index(t, name="t_s"),
+    )
+    assert segment_trace(make_trace("slow", frame, 8.131)).count == 1
+    # Slack every cycle (light weight, quick): a boundary follows every slack episode.
+    tr, _ = _trace(stand, 3.096, [])
+    seg = segment_trace(tr)
+    assert seg.count > 3
+    slack = tr.force_n < 0.1 * np.median(tr.force_n)
+    for prev, nxt in zip(seg.body[:-1], seg.body[1:], strict=True):
+        assert slack[prev:nxt].any()
+
+
+def test_chained_segments_equal_independent_ones_without_carried_states(
+    stand: StandConfig,
+) -> None:
+    # With no string modes and no bristles nothing is carried: the chained kernel's
+    # hand-over (a run split in two at the next start) must change nothing.
+    params = stand.stand_params("final", 3.096)
+    _, x = plan_motion(QUICK, stand.drive).sample(stand.sample_rate_hz)
+    rel = np.ascontiguousarray(x - x[0])
+    rows = np.stack(
+        [augmented_row(params, [EffectSpec("fibre_viscoelastic")]), augmented_row(params)]
+    )
+    starts = np.array([0, 650, 1400], dtype=np.int64)
+    lengths = np.array([700, 800, rel.size - 1400], dtype=np.int64)
+    init = np.zeros((2, 3, ek.N_INIT))
+    init[:, :, ek.I_F] = 30.0
+    knots, coef = friction_arrays(params.friction)
+    outs = []
+    for fn in (ek.simulate_segments_into, ek.simulate_chained_into):
+        u, f = np.empty((2, 3, int(lengths.max()))), np.empty((2, 3, int(lengths.max())))
+        fn(rel, 1.0 / stand.sample_rate_hz, 1, rows, knots, coef, starts, lengths, init, u, f)
+        outs.append((u, f))
+    np.testing.assert_allclose(outs[1][0], outs[0][0], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(outs[1][1], outs[0][1], rtol=0, atol=1e-7)
+
+
+def test_string_modes_carry_over_so_a_ringing_fibre_restarts_right(
+    stand: StandConfig, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # A clean recording of the true model with ringing spans (light weight, slack every
+    # cycle): restarting the spans at static sag cost 5.6x the open-loop error; carried
+    # over from the previous segment they predict as well as one open-loop run.
+    from recordings.diagnosis import fitting
+    from recordings.diagnosis.heldout import Outputs, heldout_error
+
+    effect = "fibre_transverse_vibration"
+    spec = EffectSpec(effect, {"damping_ratio": 0.012, "load_scale": 0.6})
+    tr, _ = _trace(stand, 3.096, [spec])
+    values = dict(BASE, **{f"{effect}.damping_ratio": 0.012, f"{effect}.load_scale": 0.6})
+    cand = Candidate.build(effect)
+    nominal = stand.stand_params("final", 3.096)
+    errors = []
+    for shooting in (True, False):
+        monkeypatch.setattr(fitting, "SHOOTING", shooting)
+        u, f = simulate_values(cand, [values], tr, nominal)
+        errors.append(heldout_error([tr], [Outputs(u[0], f[0])]))
+    assert segment_trace(tr).count > 3
+    assert errors[0] < 1.2 * errors[1]
