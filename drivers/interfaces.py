@@ -114,7 +114,51 @@ class DriveState:
             return f"trip {self.trip_code}"
 
 
-class DriveInterface(ABC):
+class _Device(ABC):
+    """What both interfaces share: closing, the closed-state check, the context manager.
+
+    ``close`` is idempotent; ``_close`` does the work (a drive disables itself there).
+    """
+
+    _closed: bool = False
+    name: str = "device"
+    kind: str = "device"
+
+    def _check_open(self) -> None:
+        if self._closed:
+            raise ClosedError(f"{self.name}: {self.kind} is closed")
+
+    def close(self) -> None:
+        """Release the device (a drive is disabled first if possible); idempotent."""
+        if self._closed:
+            return
+        try:
+            self._close()
+        finally:
+            self._closed = True
+
+    @property
+    def closed(self) -> bool:
+        """True once closed."""
+        return self._closed
+
+    def __enter__(self) -> Self:
+        self._check_open()
+        return self
+
+    def __exit__(
+        self,
+        exc_type: type[BaseException] | None,
+        exc: BaseException | None,
+        tb: TracebackType | None,
+    ) -> None:
+        self.close()
+
+    @abstractmethod
+    def _close(self) -> None: ...
+
+
+class DriveInterface(_Device):
     """A linear drive that runs planned motion profiles.
 
     The drive trips by itself unless ``poll()`` (or ``kick_watchdog()``) is called at
@@ -122,17 +166,13 @@ class DriveInterface(ABC):
     the stand.
     """
 
-    _closed: bool = False
     name: str = "drive"
+    kind: str = "driver"
 
     @property
     @abstractmethod
     def limits(self) -> DriveLimits:
         """The limits profiles are planned and checked against."""
-
-    def _check_open(self) -> None:
-        if self._closed:
-            raise ClosedError(f"{self.name}: driver is closed")
 
     def poll(self) -> DriveState:
         """Read position, velocity, profile state, status and trip; toggles the watchdog."""
@@ -182,32 +222,6 @@ class DriveInterface(ABC):
         self._check_open()
         self._kick_watchdog()
 
-    def close(self) -> None:
-        """Disable the drive if possible and release the connection; idempotent."""
-        if self._closed:
-            return
-        try:
-            self._close()
-        finally:
-            self._closed = True
-
-    @property
-    def closed(self) -> bool:
-        """True once closed."""
-        return self._closed
-
-    def __enter__(self) -> Self:
-        self._check_open()
-        return self
-
-    def __exit__(
-        self,
-        exc_type: type[BaseException] | None,
-        exc: BaseException | None,
-        tb: TracebackType | None,
-    ) -> None:
-        self.close()
-
     @abstractmethod
     def _poll(self) -> DriveState: ...
     @abstractmethod
@@ -226,8 +240,6 @@ class DriveInterface(ABC):
     def _reset_trip(self) -> None: ...
     @abstractmethod
     def _kick_watchdog(self) -> None: ...
-    @abstractmethod
-    def _close(self) -> None: ...
 
 
 @dataclass(frozen=True)
@@ -261,16 +273,12 @@ class GaugeStats:
     bytes_read: int = 0
 
 
-class GaugeSource(ABC):
+class GaugeSource(_Device):
     """The 2 kHz force / weight-position / drive-position samples, in blocks."""
 
-    _closed: bool = False
     name: str = "gauges"
+    kind: str = "gauge source"
     rate_hz: float = 2000.0
-
-    def _check_open(self) -> None:
-        if self._closed:
-            raise ClosedError(f"{self.name}: gauge source is closed")
 
     def read_block(self, timeout_s: float = 0.1) -> NDArray[np.void] | None:
         """The next block of samples (SAMPLE_DTYPE), or None if none came within timeout_s.
@@ -289,35 +297,7 @@ class GaugeSource(ABC):
         """Counters so far (thread-safe snapshot)."""
         return self._stats()
 
-    def close(self) -> None:
-        """Stop reading and release the port; idempotent."""
-        if self._closed:
-            return
-        try:
-            self._close()
-        finally:
-            self._closed = True
-
-    @property
-    def closed(self) -> bool:
-        """True once closed."""
-        return self._closed
-
-    def __enter__(self) -> Self:
-        self._check_open()
-        return self
-
-    def __exit__(
-        self,
-        exc_type: type[BaseException] | None,
-        exc: BaseException | None,
-        tb: TracebackType | None,
-    ) -> None:
-        self.close()
-
     @abstractmethod
     def _read_block(self, timeout_s: float) -> NDArray[np.void] | None: ...
     @abstractmethod
     def _stats(self) -> GaugeStats: ...
-    @abstractmethod
-    def _close(self) -> None: ...
