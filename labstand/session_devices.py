@@ -97,7 +97,7 @@ def open_devices(
     stand_file
         The stand file, passed on to the simulated stand.
     effects
-        Effect names the simulated stand switches on.
+        Effects the simulated stand switches on (``NAME[:param=value,...]``).
     sim_args
         Further ``labstand stand-sim`` options (tests: ``--fault``).
 
@@ -122,8 +122,8 @@ def open_devices(
     args = ["--mass-kg", repr(mass_kg)]
     if stand_file is not None:
         args += ["--stand", str(stand_file)]
-    for name in effects:
-        args += ["--effect", name]
+    for text in effects:
+        args += ["--effect", text]
     sim = StandProcess([*args, *sim_args])
     ep = sim.start()
     try:

@@ -63,8 +63,9 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
         "--effect",
         action="append",
         default=[],
-        metavar="NAME",
-        help="switch an unmodelled effect on in the simulated stand (repeatable)",
+        metavar="NAME[:param=value,...]",
+        help="switch an unmodelled effect on in the simulated stand, at default parameters "
+        "or those given (repeatable; docs/effects.md)",
     )
     parser.add_argument(
         "--speed",

@@ -131,9 +131,10 @@ class EffectSpec:
             p = info.param(key)
             value = float(raw)
             if not (math.isfinite(value) and p.minimum <= value <= p.maximum):
+                unit = "" if p.unit == "1" else f" {p.unit}"  # dimensionless: no unit
                 raise EffectError(
-                    f"{self.name}: {key} = {value:g} {p.unit} is outside its admissible range "
-                    f"[{p.minimum:g}, {p.maximum:g}] {p.unit}"
+                    f"{self.name}: {key} = {value:g}{unit} is outside its admissible range "
+                    f"[{p.minimum:g}, {p.maximum:g}]{unit}"
                 )
             values[key] = value
         if self.name == "fibre_pulley_jump" and abs(values["step_m"]) > values["depth_scale_m"]:

@@ -1,10 +1,11 @@
 """The physics behind the simulated gauges: the baseline model, with effects when asked.
 
 Effects (``sim/effects``, STAND.md §5) plug in by name through ``register_effect``: a
-factory receives the model built so far and returns one that satisfies ``StandModel``
-(it may wrap it — a gauge's dynamics, a time skew — or replace it by a richer one).
-``build_stand_model(params, rate_hz, ["name", ...])`` applies them in order. Without
-effects the simulated stand runs ``sim.model.ModelStream``, the baseline.
+factory receives the model built so far and the effect's text (``NAME[:param=value,...]``)
+and returns one that satisfies ``StandModel`` (it may wrap it — a gauge's dynamics, a
+time skew — or replace it by a richer one). ``build_stand_model(params, rate_hz,
+["name:param=value", ...])`` applies them in order. Without effects the simulated stand
+runs ``sim.model.ModelStream``, the baseline.
 """
 
 from __future__ import annotations
@@ -21,8 +22,8 @@ log = logging.getLogger(__name__)
 
 __all__ = ["EffectFactory", "available_effects", "build_stand_model", "register_effect"]
 
-#: (model so far, stand parameters, sample rate Hz) → model with the effect.
-EffectFactory = Callable[[StandModel, StandParams, float], StandModel]
+#: (model so far, stand parameters, sample rate Hz, the effect's text) → model with it.
+EffectFactory = Callable[[StandModel, StandParams, float, str], StandModel]
 _EFFECTS: dict[str, EffectFactory] = {}
 
 
@@ -44,21 +45,24 @@ def available_effects() -> list[str]:
 def build_stand_model(
     params: StandParams, rate_hz: float, effects: Sequence[str] = ()
 ) -> StandModel:
-    """The baseline model at static rest, with the named effects applied in order.
+    """The baseline model at static rest, with the effects applied in order.
+
+    Each effect is ``NAME`` (default parameters) or ``NAME:param=value,...``.
 
     Raises
     ------
     ValueError
-        An effect name nobody registered.
+        An effect name nobody registered (the factory raises for bad parameters).
     """
     model: StandModel = ModelStream(params, rate_hz)
-    wanted = [e for e in effects if e != "none"]
+    wanted = [e.strip() for e in effects if e.strip() != "none"]
     if wanted:
         known = available_effects()
-        for name in wanted:
+        for text in wanted:
+            name = text.partition(":")[0].strip()
             if name not in _EFFECTS:
                 have = ", ".join(known) or "none yet (sim/effects provides them)"
                 raise ValueError(f"unknown effect {name!r}; available: {have}")
-            model = _EFFECTS[name](model, params, rate_hz)
-            log.info("simulated stand: effect %s switched on", name)
+            model = _EFFECTS[name](model, params, rate_hz, text)
+            log.info("simulated stand: effect %s switched on", text)
     return model

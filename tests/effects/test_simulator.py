@@ -175,3 +175,17 @@ def test_the_simulated_stand_switches_effects_on_by_name(stand: StandConfig) -> 
     _, f = model.advance(x[1:] - x[0])
     offline = simulate_augmented(x - x[0], RATE, p, list(model.effects))
     assert np.allclose(f, offline.force_n[1:], rtol=0, atol=1e-9)
+
+
+def test_the_simulated_stand_takes_effect_parameters(stand: StandConfig) -> None:
+    from sim.hardware.stand_model import build_stand_model
+
+    p = stand.stand_params("final")
+    model = build_stand_model(p, RATE, ["force_gauge_dynamics:cutoff_hz=40,damping_ratio=0.9"])
+    assert isinstance(model, AugmentedStream)
+    (spec,) = model.effects
+    assert spec.resolved() == {"cutoff_hz": 40.0, "damping_ratio": 0.9}
+    with pytest.raises(EffectError, match="unknown parameter 'cutoff'"):
+        build_stand_model(p, RATE, ["force_gauge_dynamics:cutoff=40"])
+    with pytest.raises(EffectError, match="given twice"):
+        build_stand_model(p, RATE, ["channel_time_skew", "channel_time_skew:force_skew_s=0"])

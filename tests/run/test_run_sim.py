@@ -10,7 +10,7 @@ import numpy as np
 
 from recordings import open_recording
 from sim.config import config_from_dict
-from tests.run.conftest import Outcome
+from tests.run.conftest import SHORT, Outcome
 
 #: 0.5 s rest, 8 trapezoidal cycles at 1 Hz (A = 30 mm), 1.5 s rest: 10 s of profile.
 TEN_SECONDS = [
@@ -62,4 +62,21 @@ def test_ten_second_run_is_complete_and_replays(
     # measured on this run: R(u) = 1.000000, NRMSE(u) ≈ 1e-4, NRMSE(F) ≈ 1e-3
     assert metrics["u"]["R"] > 0.999
     assert metrics["u"]["nrmse"] < 0.01
+    assert metrics["F"]["nrmse"] < 0.02
+
+
+def test_an_effect_with_parameters_reaches_the_simulated_gauges(
+    labstand: Callable[..., Outcome], tmp_path: Path
+) -> None:
+    out = tmp_path / "gain.mcap"
+    effect = "dial_gauge_calibration:gain_error=0.03,offset_m=0"
+    result = labstand("run", *SHORT, "--effect", effect, "-o", out)
+    assert result.code == 0, result.err
+    (recorded,) = open_recording(out).metadata.effects
+    assert recorded.name == "dial_gauge_calibration"
+    assert recorded.params["gain_error"] == 0.03
+    # A dial gauge reading 3 % high: u is off the model by its gain, F untouched.
+    replay = labstand("replay", out, "--json")
+    metrics = json.loads(replay.out)["channels"]
+    assert metrics["u"]["nrmse"] > 0.005
     assert metrics["F"]["nrmse"] < 0.02

@@ -213,9 +213,14 @@ def stand_file(tmp_path: Path) -> Path:
         (["--backend", "stand"], ExitCode.USAGE, "no [devices] table"),
         (["--effect", "no_such"], ExitCode.USAGE, "unknown effect 'no_such'"),
         (
-            ["--effect", "channel_time_skew:force_skew_s=0.001"],
+            ["--effect", "channel_time_skew:no_such=1"],
             ExitCode.USAGE,
-            "default parameters only",
+            "channel_time_skew: unknown parameter 'no_such'",
+        ),
+        (
+            ["--effect", "dial_gauge_calibration:gain_error=0.9"],
+            ExitCode.USAGE,
+            "gain_error = 0.9 is outside its admissible range [-0.5, 0.5]",
         ),
         (["--slack-max-s", "0"], ExitCode.USAGE, "slack_max_s must be > 0"),
         (["-o", "no/such/dir/x.mcap"], ExitCode.USAGE, "no/such/dir: no such directory"),
