@@ -26,7 +26,9 @@ at most one segment and the fit compares the model's short-term dynamics with th
   effect is inverted first (the dial gauge's gain and offset, the displacement channel's
   skew), so the state is the true one the candidate implies. The effects' own states are
   set by ``sim.effects.kernel.measured_state``: quasi-static values, and for the Maxwell
-  branch its response to the measured elongation history.
+  branch its response to the measured elongation history. Those the gauges cannot see at
+  a start (string modes, LuGre bristle, pulley seat) carry over from the previous
+  segment's run instead (``simulate_chained_into``).
 * The first segment starts at sample 0 from static rest, exactly as an open-loop run.
 
 Held-out cycles are then judged on segment predictions as well; that is fair because
@@ -193,30 +195,7 @@ def start_states(seg: Segments, trace: Trace, rows: FloatArray) -> FloatArray:
     for b, row in enumerate(rows2):
         if row[ek.R_VE_ON] > 0:
             init[b, :, ek.I_HP] = _branch_elongation(seg, trace, row)[idx]
-        if row[ek.R_PJ_ON] > 0:
-            init[b, :, ek.I_SEAT] = _seat(seg, trace, row)[idx]
     return init
-
-
-def _seat(seg: Segments, trace: Trace, row: FloatArray) -> FloatArray:
-    """The pulley-jump seat offset (m) along the trace, from the last taut sample.
-
-    While taut the measured force fixes the elongation, so the seat is what the
-    elongation computed from the measured x and u lacks, (F − F_home)/k, rounded to the
-    nearer of the two seats 0 and step_m. While slack: the seat of the last taut sample.
-    """
-    k, damp, n = row[ek.P_STIFF], row[ek.P_DAMP], row[ek.P_PROJ]
-    x = trace.x_m - trace.x_m[0]
-    xd = np.gradient(x, 1.0 / trace.rate_hz)
-    home = k * (row[ek.P_PRELOAD] + x - n * seg.u_m) + damp * (xd - n * seg.v_m_s)
-    step = row[ek.R_PJ_STEP]
-    # Only the two seats: a continuous estimate would let the seat soak up any elongation
-    # mismatch (a gauge gain error, say) at every segment start.
-    est = np.where(np.abs((seg.force_n - home) / k - step) < 0.5 * abs(step), step, 0.0)
-    taut = seg.force_n > 0.25 * row[ek.P_GRAVITY_N] / n
-    last = np.maximum.accumulate(np.where(taut, np.arange(taut.size), 0))
-    out: FloatArray = np.where(taut[last], est[last], 0.0)
-    return out
 
 
 def _branch_elongation(seg: Segments, trace: Trace, row: FloatArray) -> FloatArray:

@@ -530,8 +530,8 @@ def simulate_batch_into(x, dt, substeps, rows, knots, coef, out_u, out_v, out_t1
 
 
 # Measured start state of a segment (``simulate_segments_into``): columns of init[b, s].
-(I_U, I_V, I_F, I_HP, I_SEAT) = range(5)
-N_INIT = 5
+(I_U, I_V, I_F, I_HP) = range(4)
+N_INIT = 4
 
 
 @njit(cache=True, error_model="numpy")
@@ -547,7 +547,10 @@ def measured_state(c, x, xd, m):  # type: ignore[no-untyped-def]
     for the measured tension (rest sag while slack; ``simulate_chained_into`` replaces
     them by the previous segment's); LuGre bristle holding the measured
     force balance n·F − m·g·sin α, limited to (and, faster than v_s, at) its sliding
-    value; pulley-jump seat m[I_SEAT] (the caller's estimate from the last taut sample).
+    value; pulley-jump seat at its base (``simulate_chained_into`` carries the real one:
+    a seat estimated from the measured elongation, rounded to one of the two grooves,
+    picked the wrong groove often enough to cost 340× the open-loop error on a clean
+    recording).
     Sets the discrete state in c; returns the continuous state tuple.
     """
     u, v, force = m[I_U], m[I_V], m[I_F]
@@ -577,7 +580,7 @@ def measured_state(c, x, xd, m):  # type: ignore[no-untyped-def]
     q1, q2 = c[D_KB1] * m[I_HP], c[D_KB2] * m[I_HP]
     y = (u, v, s, sd, q1, q2, a1, 0.0, a2, 0.0, z)
     c[S_DEPTH] = 0.0
-    c[S_LOFF], c[S_LBASE] = m[I_SEAT], m[I_SEAT]
+    c[S_LOFF], c[S_LBASE] = 0.0, 0.0
     c[S_PZ], c[S_PS0] = 0.0, s
     if c[D_NSEG] > 1.5 and c[D_SIGP] > 0.0:
         _set_taut(c, y, x, xd)
@@ -591,16 +594,19 @@ def measured_state(c, x, xd, m):  # type: ignore[no-untyped-def]
 def simulate_chained_into(x, dt, substeps, rows, knots, coef, starts, lens, init, out_u, out_t1):  # type: ignore[no-untyped-def]
     """``simulate_segments_into`` segment after segment per row (parallel over rows only).
 
-    The string modes and the LuGre bristle are not observable from the gauges at a start
-    (a ringing span's phase; the bristle's pre-sliding while sticking), but they are stable
-    and driven by the tension and the weight's motion: simulating them is their observer.
-    So every segment after the first starts them where the previous segment's run had
-    them at that sample; everything else starts from ``measured_state`` as before.
+    The string modes, the LuGre bristle and the pulley seat are not observable from the
+    gauges at a start (a ringing span's phase; the bristle's pre-sliding while sticking;
+    which groove the fibre sits in, a step of a tenth of a millimetre in a noisy
+    elongation), but they are driven by the tension and the weight's motion: simulating
+    them is their observer. So every segment after the first starts them where the
+    previous segment's run had them at that sample; everything else starts from
+    ``measured_state`` as before.
     """
     sets = rows.shape[0]
     segs = starts.shape[0]
     for b in prange(sets):
         carried = np.zeros(NY - Y_A1)
+        seat = np.zeros(3)  # the pulley-jump seat: S_LOFF, S_LBASE, S_DEPTH
         have = False
         for s in range(segs):
             n = lens[s]
@@ -621,6 +627,7 @@ def simulate_chained_into(x, dt, substeps, rows, knots, coef, starts, lens, init
                         y[0], y[1], y[2], y[3], y[4], y[5],
                         carried[0], carried[1], carried[2], carried[3], carried[4],
                     )  # fmt: skip
+                    c[S_LOFF], c[S_LBASE], c[S_DEPTH] = seat[0], seat[1], seat[2]
                 _set_taut(c, y, xs[0], xd)
                 _sample_out(c, y, xs[0], xd, 0, ou, sv, ot, st2)
             state = np.empty(NY)
@@ -632,6 +639,7 @@ def simulate_chained_into(x, dt, substeps, rows, knots, coef, starts, lens, init
                 advance_into(xs[:h1], dt, substeps, c, state, ou[:h1], sv[:h1], ot[:h1], st2[:h1])
                 for k in range(NY - Y_A1):
                     carried[k] = state[Y_A1 + k]
+                seat[0], seat[1], seat[2] = c[S_LOFF], c[S_LBASE], c[S_DEPTH]
                 have = True
                 tail = slice(hand, n)
                 advance_into(

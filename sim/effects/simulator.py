@@ -233,16 +233,21 @@ def simulate_augmented_segments(
     ``init`` (sets, segments, ``ek.N_INIT``) holds each segment's measured start (u m,
     v m/s, F N, high-passed elongation m; see ``ek.measured_state`` for how the effects'
     own states are set from it); a segment starting at sample 0 starts from static rest;
-    string modes and bristles carry over from the previous segment's run. Returns the
-    *recorded* u (m) and F (N), shape (sets, segments, max length), each segment measured
-    on its own (``measure_segments``), last value held past its end.
+    string modes, bristles and the pulley seat carry over from the previous segment's
+    run. Returns the *recorded* u (m) and F (N), shape (sets, segments, max length), each
+    segment measured on its own (``measure_segments``), last value held past its end.
     """
     rows2 = np.ascontiguousarray(np.atleast_2d(rows), dtype=np.float64)
     sets, segs, width = rows2.shape[0], starts.shape[0], int(lengths.max())
     u, t1 = np.empty((sets, segs, width)), np.empty((sets, segs, width))
     knots, coef = friction_arrays(table)
-    # String modes and bristles carry over between segments (see simulate_chained_into).
-    chained = bool((rows2[:, ek.R_TV_ON] > 0).any() or (rows2[:, ek.R_SS_ON] > 0).any())
+    # String modes, bristles and the pulley seat carry over between segments (see
+    # simulate_chained_into).
+    chained = bool(
+        (rows2[:, ek.R_TV_ON] > 0).any()
+        or (rows2[:, ek.R_SS_ON] > 0).any()
+        or (rows2[:, ek.R_PJ_ON] > 0).any()
+    )
     kernel = ek.simulate_chained_into if chained else ek.simulate_segments_into
     kernel(
         np.ascontiguousarray(x_rel_m, dtype=np.float64), 1.0 / rate_hz, substeps, rows2,
