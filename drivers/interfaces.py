@@ -14,12 +14,12 @@ from __future__ import annotations
 import logging
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
-from types import TracebackType
 from typing import Self
 
 import numpy as np
 from numpy.typing import NDArray
 
+from drivers.closing import ClosesOnExit
 from drivers.limits import DriveLimits
 from drivers.signals import DriveProfile, SignalSpec
 from drivers.unidrive_profile import ProfileState
@@ -114,7 +114,7 @@ class DriveState:
             return f"trip {self.trip_code}"
 
 
-class _Device(ABC):
+class _Device(ClosesOnExit, ABC):
     """What both interfaces share: closing, the closed-state check, the context manager.
 
     ``close`` is idempotent; ``_close`` does the work (a drive disables itself there).
@@ -145,14 +145,6 @@ class _Device(ABC):
     def __enter__(self) -> Self:
         self._check_open()
         return self
-
-    def __exit__(
-        self,
-        exc_type: type[BaseException] | None,
-        exc: BaseException | None,
-        tb: TracebackType | None,
-    ) -> None:
-        self.close()
 
     @abstractmethod
     def _close(self) -> None: ...

@@ -11,13 +11,14 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
-from types import TracebackType
-from typing import Self, TextIO
+from typing import TextIO
 
 from rich.console import Console, Group
 from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 from rich.table import Table
 from rich.text import Text
+
+from drivers.closing import ClosesOnExit
 
 __all__ = ["Display", "LiveDisplay", "PlainDisplay", "RunStatus", "make_display"]
 
@@ -55,7 +56,7 @@ class RunStatus:
     drive: str
 
 
-class Display:
+class Display(ClosesOnExit):
     """No display at all (and the interface of the others)."""
 
     interval_s = 1.0
@@ -72,17 +73,6 @@ class Display:
 
     def _show(self, status: RunStatus) -> None:
         pass
-
-    def __enter__(self) -> Self:
-        return self
-
-    def __exit__(
-        self,
-        exc_type: type[BaseException] | None,
-        exc: BaseException | None,
-        tb: TracebackType | None,
-    ) -> None:
-        self.close()
 
     def close(self) -> None:
         """Leave the terminal as it should be."""

@@ -13,12 +13,12 @@ import logging
 import queue
 import threading
 from dataclasses import dataclass
-from types import TracebackType
-from typing import Any, Self
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
+from drivers.closing import ClosesOnExit
 from drivers.interfaces import DriveState
 from drivers.signals import DriveProfile
 from recordings.base import RecordingWriter
@@ -99,7 +99,7 @@ class _Item:
     payload: Any
 
 
-class RecordingPipe:
+class RecordingPipe(ClosesOnExit):
     """A RecordingWriter fed through a queue by a thread of its own.
 
     ``put_*`` never block (the queue is unbounded: the writer is two orders of magnitude
@@ -171,14 +171,3 @@ class RecordingPipe:
         except Exception as err:
             self.error = self.error or err
             raise
-
-    def __enter__(self) -> Self:
-        return self
-
-    def __exit__(
-        self,
-        exc_type: type[BaseException] | None,
-        exc: BaseException | None,
-        tb: TracebackType | None,
-    ) -> None:
-        self.close()

@@ -14,12 +14,12 @@ import time
 from abc import ABC, abstractmethod
 from collections.abc import Callable
 from pathlib import Path
-from types import TracebackType
-from typing import Any, ClassVar, Self
+from typing import Any, ClassVar
 
 import numpy as np
 from numpy.typing import NDArray
 
+from drivers.closing import ClosesOnExit
 from recordings.errors import InvalidDataError, UnknownFormatError, WriterClosedError
 from recordings.schema import (
     COMMAND_DTYPE,
@@ -78,7 +78,7 @@ def check_stream(where: str, stream: str, block: NDArray[np.void], strict: bool 
             )
 
 
-class RecordingWriter(ABC):
+class RecordingWriter(ClosesOnExit, ABC):
     """Streams one recording to a file; a context manager that refuses writes once closed.
 
     Subclasses implement the ``_write_*``, ``_flush`` and ``_close`` hooks; this class owns
@@ -166,17 +166,6 @@ class RecordingWriter(ABC):
         finally:
             self.closed = True
         log.debug("closed %s", self.path)
-
-    def __enter__(self) -> Self:
-        return self
-
-    def __exit__(
-        self,
-        exc_type: type[BaseException] | None,
-        exc: BaseException | None,
-        tb: TracebackType | None,
-    ) -> None:
-        self.close()
 
     # -- hooks ----------------------------------------------------------------------------
     @abstractmethod
