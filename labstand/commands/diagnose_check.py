@@ -17,7 +17,7 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
         "diagnose-check",
         help="score the diagnosis on generated recordings whose effect is withheld",
         description="For every effect and for 'none', at both weight masses, draw a real-like "
-        "stand (±25 %% mismatch), a random effect magnitude and realistic noise, simulate a "
+        "stand (±25 % mismatch), a random effect magnitude and realistic noise, simulate a "
         "quick, a medium and a slow recording, diagnose them blind, and score the answers.",
     )
     add_stand_options(parser)
