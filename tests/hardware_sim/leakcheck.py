@@ -18,6 +18,15 @@ import pytest
 GRACE_S = 3.0
 
 
+def gone(pid: int) -> bool:
+    """The process has exited (a zombie of a dead parent counts as exited)."""
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except (FileNotFoundError, ProcessLookupError):
+        return True
+    return state in {"Z", "X"}
+
+
 def _fds() -> dict[int, str]:
     out = {}
     for entry in Path("/proc/self/fd").iterdir():

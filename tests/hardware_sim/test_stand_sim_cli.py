@@ -18,15 +18,7 @@ from drivers.unidrive import open_unidrive
 from labstand.cli import main
 from labstand.commands.stand_sim import StandProcess, wait_exit
 from sim.config import StandConfig
-
-
-def gone(pid: int) -> bool:
-    """The process has exited (a zombie whose parent died counts as exited)."""
-    try:
-        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
-    except (FileNotFoundError, ProcessLookupError):
-        return True
-    return state in {"Z", "X"}
+from tests.hardware_sim.leakcheck import gone
 
 
 def test_endpoints_are_reachable_and_sigterm_stops_cleanly(config: StandConfig) -> None:

@@ -22,7 +22,7 @@ from pathlib import Path
 import pytest
 
 from labstand.cli import main
-from tests.hardware_sim.leakcheck import no_leaks
+from tests.hardware_sim.leakcheck import gone, no_leaks
 
 __all__ = ["no_leaks"]
 
@@ -66,15 +66,6 @@ def wait_for(predicate: Callable[[], object], timeout_s: float, what: str) -> No
         if time.monotonic() > deadline:
             pytest.fail(f"timed out after {timeout_s:g} s waiting for {what}")
         time.sleep(0.02)
-
-
-def gone(pid: int) -> bool:
-    """The process has exited (a zombie of a dead parent counts as exited)."""
-    try:
-        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
-    except (FileNotFoundError, ProcessLookupError):
-        return True
-    return state in {"Z", "X"}
 
 
 @pytest.fixture
