@@ -11,6 +11,7 @@ import numpy as np
 
 from labstand.plots import pyplot
 from recordings.diagnosis import Diagnosis, Trace
+from recordings.diagnosis.diagnose import MIN_GAP_CLOSURE
 from recordings.diagnosis.traces import PHASES
 
 PHASE_COLOURS = {"rise": "tab:red", "hold": "tab:orange", "fall": "tab:blue", "rest": "tab:gray"}
@@ -61,7 +62,7 @@ def _ranking_plot(path: Path, result: Diagnosis) -> None:
     ax.barh(y + 0.2, screening, height=0.4, color="tab:gray", label="screening (residual share)")
     ax.barh(y - 0.2, scores, height=0.4, color="tab:green", label="held-out gap closure (refitted)")
     ax.set_yticks(y, names)
-    ax.axvline(0.3, color="k", ls=":", lw=0.8, label="closure needed")
+    ax.axvline(MIN_GAP_CLOSURE, color="k", ls=":", lw=0.8, label="closure needed")
     ax.set_xlim(min(0.0, *scores) - 0.05, 1.05)
     ax.legend(fontsize=8, loc="lower right")
     ax.set_title(f"Ranking — answer: {result.effect}")
@@ -135,8 +136,8 @@ tr:nth-child(even){{background:#f3f3f3}}</style>
 </head><body>
 <h1>Diagnosis: <code>{html.escape(result.effect)}</code></h1>
 <p>Recordings: {", ".join(html.escape(t.name) for t in traces)}.
-Held-out error {result.heldout_error_before:.4g} → {result.heldout_error_after:.4g}
-(noise floor {result.noise_floor:.4g}; gap closure {result.gap_closure:.2f};
+Held-out NRMSE {result.heldout_error_before:.4g} → {result.heldout_error_after:.4g}
+(noise alone {result.noise_floor:.4g}; gap closure in noise units {result.gap_closure:.2f};
 bootstrap confidence {result.confidence:.2f}).</p>
 <h2>How far the gap shrinks (held-out cycles)</h2>
 <h3>before</h3>{_table(data["gap_before"])}<h3>after</h3>{_table(data["gap_after"])}

@@ -275,7 +275,7 @@ def diagnose(
     for res, _, _ in refits.values():
         values = {p.name: res.values[p.name] for p in base_fit.candidate.params}
         outs = _outputs(base_fit.candidate, values, traces, nominal)
-        sims += 1
+        sims += len(traces)
         excess = heldout_excess(traces, outs)
         if excess < x_base:
             base_values, base_out, x_base = values, outs, excess
