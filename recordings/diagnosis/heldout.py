@@ -83,12 +83,11 @@ def _noise_scale(rec: FloatArray, noise: float) -> float:
 def heldout_excess(traces: Sequence[Trace], outputs: Sequence[Outputs]) -> float:
     """Held-out rms error in units of each channel's noise, RMS over traces and channels.
 
-    1 is a perfect model.
-    This is what decides between candidates. Each channel counts by how far its error
-    stands above its own noise (the Gaussian likelihood's weighting), so a precise dial
-    gauge's systematic error is not drowned by a noisier channel: pooled NRMSE diluted a
-    gauge gain error that cut the u channels' error 3–10× into a 6 % change, below every
-    threshold.
+    1 is a perfect model. This is what decides between candidates: each channel counts
+    by how far its error stands above its own noise (the Gaussian likelihood's
+    weighting), so a precise dial gauge's systematic error is not drowned by a noisier
+    channel. Pooled NRMSE diluted a gauge gain error that cut the u channels' error
+    3–10× into a 6 % change, below every threshold.
     """
     ratios = []
     for tr, out in zip(traces, outputs, strict=True):
