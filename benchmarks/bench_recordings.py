@@ -29,7 +29,7 @@ from recordings import (
     open_writer,
 )
 from sim.config import default_config
-from sim.model import simulate
+from sim.model import Model
 
 
 def make_data(minutes: float, quantise: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -40,7 +40,7 @@ def make_data(minutes: float, quantise: bool) -> tuple[np.ndarray, np.ndarray, n
     _, x_m = plan_motion(spec, config.drive).sample(rate)
     n = int(minutes * 60 * rate)
     x_m = x_m[:n]
-    res = simulate(x_m, rate, config.stand_params("final"))
+    res = Model(config.stand_params("final")).run(x_m, rate)
     g = np.zeros(len(x_m), GAUGES_DTYPE)
     g["seq"] = np.arange(len(x_m))
     g["t_ns"] = np.arange(len(x_m)) * int(1e9 / rate)

@@ -17,20 +17,59 @@ Exceptions::
      └── ClosedError            a driver used after close()
 """
 
-from drivers.calibration import GaugeCalibration
-from drivers.gauge_stream import GaugeError, SerialGaugeStream, open_gauges
-from drivers.interfaces import (
-    SAMPLE_DTYPE,
-    ClosedError,
-    DriveInterface,
-    DriveState,
-    GaugeSource,
-    GaugeStats,
-)
-from drivers.limits import DriveLimits, LimitError
-from drivers.signals import DriveProfile, Shape, SignalSpec, plan_motion
-from drivers.unidrive import DriveError, UnidriveSP, open_unidrive
-from drivers.unidrive_profile import ProfileState
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
+
+# Lazy re-exports (PEP 562): importing one driver module (``drivers.signals`` for the
+# model, say) must not load pymodbus and pyserial through this package.
+_EXPORTS = {
+    "GaugeCalibration": "drivers.calibration",
+    "GaugeError": "drivers.gauge_stream",
+    "SerialGaugeStream": "drivers.gauge_stream",
+    "open_gauges": "drivers.gauge_stream",
+    "SAMPLE_DTYPE": "drivers.interfaces",
+    "ClosedError": "drivers.interfaces",
+    "DriveInterface": "drivers.interfaces",
+    "DriveState": "drivers.interfaces",
+    "GaugeSource": "drivers.interfaces",
+    "GaugeStats": "drivers.interfaces",
+    "DriveLimits": "drivers.limits",
+    "LimitError": "drivers.limits",
+    "DriveProfile": "drivers.signals",
+    "Shape": "drivers.signals",
+    "SignalSpec": "drivers.signals",
+    "plan_motion": "drivers.signals",
+    "DriveError": "drivers.unidrive",
+    "UnidriveSP": "drivers.unidrive",
+    "open_unidrive": "drivers.unidrive",
+    "ProfileState": "drivers.unidrive_profile",
+}
+
+if TYPE_CHECKING:
+    from drivers.calibration import GaugeCalibration
+    from drivers.gauge_stream import GaugeError, SerialGaugeStream, open_gauges
+    from drivers.interfaces import (
+        SAMPLE_DTYPE,
+        ClosedError,
+        DriveInterface,
+        DriveState,
+        GaugeSource,
+        GaugeStats,
+    )
+    from drivers.limits import DriveLimits, LimitError
+    from drivers.signals import DriveProfile, Shape, SignalSpec, plan_motion
+    from drivers.unidrive import DriveError, UnidriveSP, open_unidrive
+    from drivers.unidrive_profile import ProfileState
+
+
+def __getattr__(name: str) -> Any:
+    module = _EXPORTS.get(name)
+    if module is None:
+        raise AttributeError(f"module 'drivers' has no attribute {name!r}")
+    return getattr(importlib.import_module(module), name)
+
 
 __all__ = [
     "SAMPLE_DTYPE",

@@ -17,7 +17,7 @@ from labstand import __version__
 from labstand.errors import CommandError, ExitCode
 from recordings.errors import RecordingError
 from sim.config import ConfigError
-from sim.model import SimulationError
+from sim.errors import SimulationError
 
 #: Sub-command modules, in the order ``--help`` lists them.
 COMMANDS = [

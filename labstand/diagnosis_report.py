@@ -4,15 +4,14 @@ from __future__ import annotations
 
 import html
 import json
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 import numpy as np
 
 from labstand.plots import pyplot
-from recordings.diagnosis import Diagnosis, Trace
-from recordings.diagnosis.diagnose import MIN_GAP_CLOSURE
-from recordings.diagnosis.traces import PHASES
+from sim.identify import Diagnosis, Trace
+from sim.identify.traces import PHASES
 
 PHASE_COLOURS = {"rise": "tab:red", "hold": "tab:orange", "fall": "tab:blue", "rest": "tab:gray"}
 
@@ -54,15 +53,15 @@ def _residual_plot(path: Path, traces: Sequence[Trace], result: Diagnosis) -> No
 
 def _ranking_plot(path: Path, result: Diagnosis) -> None:
     plt = pyplot()
-    names = [r["effect"] for r in result.ranking]
-    screening = [r["screening"] for r in result.ranking]
-    scores = [r["score"] if r["score"] is not None else 0.0 for r in result.ranking]
+    names = [r.effect for r in result.ranking]
+    screening = [r.screening for r in result.ranking]
+    scores = [r.score if r.score is not None else 0.0 for r in result.ranking]
     fig, ax = plt.subplots(figsize=(9, 4), constrained_layout=True)
     y = np.arange(len(names))[::-1]
     ax.barh(y + 0.2, screening, height=0.4, color="tab:gray", label="screening (residual share)")
     ax.barh(y - 0.2, scores, height=0.4, color="tab:green", label="held-out gap closure (refitted)")
     ax.set_yticks(y, names)
-    ax.axvline(MIN_GAP_CLOSURE, color="k", ls=":", lw=0.8, label="closure needed")
+    ax.axvline(result.closure_needed, color="k", ls=":", lw=0.8, label="closure needed")
     ax.set_xlim(min(0.0, *scores) - 0.05, 1.05)
     ax.legend(fontsize=8, loc="lower right")
     ax.set_title(f"Ranking — answer: {result.effect}")
@@ -99,7 +98,7 @@ def _overlay_plot(path: Path, traces: Sequence[Trace], result: Diagnosis) -> Non
     plt.close(fig)
 
 
-def _table(rows: dict[str, object]) -> str:
+def _table(rows: Mapping[str, object]) -> str:
     cells = "".join(
         f"<tr><th>{html.escape(str(k))}</th><td>{_fmt(v)}</td></tr>" for k, v in rows.items()
     )
@@ -120,13 +119,12 @@ def write_report(directory: Path, traces: Sequence[Trace], result: Diagnosis) ->
     _residual_plot(directory / "residual.png", traces, result)
     _ranking_plot(directory / "ranking.png", result)
     _overlay_plot(directory / "overlay.png", traces, result)
-    data = result.to_dict()
-    (directory / "result.json").write_text(json.dumps(data, indent=2))
-    where = data["where"]
+    (directory / "result.json").write_text(json.dumps(result.to_dict(), indent=2))
+    where = result.where
     ranking_rows = "".join(
-        f"<tr><td>{html.escape(r['effect'])}</td><td>{_fmt(r['score'])}</td>"
-        f"<td>{_fmt(r['screening'])}</td><td>{_fmt(r['params'])}</td></tr>"
-        for r in data["ranking"]
+        f"<tr><td>{html.escape(r.effect)}</td><td>{_fmt(r.score)}</td>"
+        f"<td>{_fmt(r.screening)}</td><td>{_fmt(r.params)}</td></tr>"
+        for r in result.ranking
     )
     page = f"""<!doctype html>
 <html><head><meta charset="utf-8"><title>labstand diagnosis: {html.escape(result.effect)}</title>
@@ -140,20 +138,20 @@ Held-out NRMSE {result.heldout_error_before:.4g} → {result.heldout_error_after
 (noise alone {result.noise_floor:.4g}; gap closure in noise units {result.gap_closure:.2f};
 bootstrap confidence {result.confidence:.2f}).</p>
 <h2>How far the gap shrinks (held-out cycles)</h2>
-<h3>before</h3>{_table(data["gap_before"])}<h3>after</h3>{_table(data["gap_after"])}
+<h3>before</h3>{_table(result.gap_before)}<h3>after</h3>{_table(result.gap_after)}
 <h2>Which effect</h2><img src="ranking.png" alt="ranking">
 <table><tr><th>effect</th><th>held-out gap closure</th><th>screening</th>
 <th>fitted parameters</th></tr>
 {ranking_rows}</table>
 <h2>Where the gap lies</h2>
 <p>Shares of the fitted baseline's squared residual.</p>
-<h3>by channel</h3>{_table(where["channel"])}
-<h3>by phase of the drive motion</h3>{_table(where["phase"])}
-<h3>by regime</h3>{_table(where["regime"])}
-<h3>by frequency band</h3>{_table(where["band"])}
+<h3>by channel</h3>{_table(where.channel)}
+<h3>by phase of the drive motion</h3>{_table(where.phase)}
+<h3>by regime</h3>{_table(where.regime)}
+<h3>by frequency band</h3>{_table(where.band)}
 <img src="residual.png" alt="residual over time coloured by phase">
 <h2>Recorded, baseline and augmented model</h2><img src="overlay.png" alt="overlay">
-<h2>Fitted baseline</h2>{_table(data["baseline_fit"])}
+<h2>Fitted baseline</h2>{_table(result.baseline)}
 </body></html>
 """
     index = directory / "index.html"

@@ -12,7 +12,7 @@ from recordings.convert import write_streams
 from recordings.csvio import write_csv
 from recordings.schema import COMMAND_DTYPE, GAUGES_DTYPE, Backend, make_metadata
 from sim.config import StandConfig
-from sim.model import SimResult
+from sim.results import SimResult
 
 SUFFIXES = (".csv", ".mcap", ".h5", ".hdf5")
 

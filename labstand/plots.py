@@ -6,7 +6,7 @@ from pathlib import Path
 from types import ModuleType
 
 from recordings.replay import ReplayResult
-from sim.model import SimResult
+from sim.results import SimResult
 
 _UNITS = {"u": "weight u [mm]", "F": "fibre force F [N]", "F_dyn": "dynamic force F − T₀ [N]"}
 

@@ -2,7 +2,7 @@
 
 The recording's measured drive position drives the baseline model; the simulated weight
 displacement u and fibre force F are compared with the recorded ones per channel with the
-paper's measures (recordings.metrics). Channels:
+paper's measures (sim.metrics). Channels:
 
 * ``u`` — weight displacement, mm, both measured from their rest value before the motion;
 * ``F`` — fibre force, N, absolute (the gauge reads the whole tension);
@@ -22,8 +22,9 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
-from recordings.metrics import ChannelMetrics, channel_metrics
-from sim.model import simulate
+from sim.grid import AlignedRun, GridError, align_arrays
+from sim.metrics import ChannelMetrics, channel_metrics
+from sim.model import Model
 from sim.params import StandParams
 
 FloatArray = NDArray[np.float64]
@@ -32,8 +33,6 @@ log = logging.getLogger(__name__)
 
 __all__ = ["AlignedRun", "ReplayResult", "align", "compare_runs", "replay"]
 
-#: The drive counts as at rest while within this distance of its first position, m.
-REST_TOLERANCE_M = 0.05e-3
 CHANNELS = ("u", "F", "F_dyn")
 
 
@@ -41,63 +40,21 @@ class ReplayError(ValueError):
     """A recording that cannot be replayed (too short, no drive motion, no channel)."""
 
 
-@dataclass(frozen=True)
-class AlignedRun:
-    """A recording on a uniform time grid (SI units); ``present`` marks real samples."""
-
-    t_s: FloatArray
-    x_m: FloatArray
-    u_m: FloatArray
-    force_n: FloatArray
-    present: BoolArray
-    rate_hz: float
-    rest_samples: int  # samples before the drive first moves
-
-    @property
-    def lost_samples(self) -> int:
-        """Grid points the recording has no sample for."""
-        return int(self.present.size - np.count_nonzero(self.present))
-
-
-def _rate_from_index(t_s: FloatArray) -> float:
-    steps = np.diff(t_s)
-    if steps.size == 0 or not np.all(steps > 0):
-        raise ReplayError("the time base is not strictly increasing")
-    return float(1.0 / np.median(steps))
-
-
 def align(frame: pd.DataFrame, rate_hz: float | None = None) -> AlignedRun:
     """Put a recording's x, u, F on a uniform grid (the recording's own rate)."""
     for column in ("x_mm", "u_mm", "F_N"):
         if column not in frame.columns:
             raise ReplayError(f"the recording has no {column} channel")
-    t = np.asarray(frame.index, dtype=np.float64)
-    if t.size < 2:
-        raise ReplayError(f"the recording has {t.size} sample(s); replay needs a run")
-    rate = rate_hz or _rate_from_index(t)
-    slot = np.rint((t - t[0]) * rate).astype(np.int64)
-    if np.any(np.diff(slot) <= 0):
-        raise ReplayError("samples do not fall on a uniform grid at the recording's rate")
-    n = int(slot[-1]) + 1
-    grid_t = t[0] + np.arange(n) / rate
-    present = np.zeros(n, dtype=bool)
-    present[slot] = True
-
-    def on_grid(values: FloatArray) -> FloatArray:
-        out = np.full(n, np.nan)
-        out[slot] = values
-        return out
-
-    x_rec = np.asarray(frame["x_mm"], dtype=np.float64) * 1e-3
-    x = np.interp(grid_t, t, x_rec)  # bridges lost samples for the model
-    u = on_grid(np.asarray(frame["u_mm"], dtype=np.float64) * 1e-3)
-    f = on_grid(np.asarray(frame["F_N"], dtype=np.float64))
-    moving = np.flatnonzero(np.abs(x - x[0]) > REST_TOLERANCE_M)
-    if not moving.size:
-        raise ReplayError("the drive never moves in this recording: nothing to replay")
-    # The weight reacts before x has moved by the tolerance: keep a 20 ms margin.
-    rest = max(1, int(moving[0]) - int(0.02 * rate))
-    return AlignedRun(grid_t - grid_t[0], x, u, f, present, rate, rest)
+    try:
+        return align_arrays(
+            np.asarray(frame.index, dtype=np.float64),
+            np.asarray(frame["x_mm"], dtype=np.float64) * 1e-3,
+            np.asarray(frame["u_mm"], dtype=np.float64) * 1e-3,
+            np.asarray(frame["F_N"], dtype=np.float64),
+            rate_hz,
+        )
+    except GridError as err:
+        raise ReplayError(str(err).replace("nothing to compare", "nothing to replay")) from None
 
 
 def _rest_value(values: FloatArray, rest_samples: int) -> float:
@@ -149,7 +106,7 @@ def _measure(
 def replay(frame: pd.DataFrame, params: StandParams) -> ReplayResult:
     """Drive the model with the recording's x and compare u, F, F − T₀."""
     run = align(frame)
-    sim = simulate(run.x_m, run.rate_hz, params)
+    sim = Model(params).run(run.x_m, run.rate_hz)
     recorded = _channels(run.u_m, run.force_n, run.rest_samples)
     simulated = {
         "u": sim.u_m * 1e3,

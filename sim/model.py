@@ -1,273 +1,266 @@
-"""The baseline model of STAND.md §2: run it on a drive position series.
+"""The one front door to the stand's model: a stand, the effects switched on, and its runs.
 
-``simulate`` runs one parameter set; ``simulate_batch`` runs many at once on all cores
-(fitting and diagnosis call it thousands of times). The compiled integrator lives in
-``sim.kernel``; this module turns StandParams into its flat arrays and back.
+``Model(stand, effects)`` is how everything outside the model runs it — ``simulate``,
+replay, the simulated stand's gauges and the diagnosis alike::
+
+    model = Model(stand, [EffectSpec("fibre_viscoelastic", {"relaxation_time_s": 0.02})])
+    run = model.run(x_m, rate_hz)                        # one run from static rest
+    batch = model.run_batch(x_m, rate_hz, variants)      # many parameter sets at once
+    u, f = model.run_segments(x_m, rate_hz, restarts, variants)  # multiple shooting
+    stream = model.stream(rate_hz)                       # block by block, in real time
+
+The model alone decides how: without physical effects it runs the baseline's fast kernel
+(``sim.kernel``), with them the augmented kernel (``sim.effects.kernel``); measurement
+effects (gauge calibration, skew, gauge dynamics) then transform the outputs. Segment
+runs restart from measured channels: the model inverts its own gauge effects to get the
+true state, sets the effects' states from the measurements, and carries over from the
+previous segment the states the gauges cannot see (string modes, LuGre bristle, pulley
+seat). The kernels are private to ``sim`` (an import-linter contract).
+
+Variants name the parameters they change: a ``StandParams`` field (``stiffness_n_m``,
+``damping_n_s_m``, ``friction_scale``, ``mass_kg``, ...) or ``"<effect>.<param>"`` of an
+effect the model has.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-from dataclasses import dataclass
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, fields
+from typing import Protocol
 
 import numpy as np
 from numpy.typing import NDArray
 
-from sim import kernel
-from sim.params import FrictionTable, StandParams
+from sim import _baseline
+from sim._baseline import DEFAULT_SUBSTEPS, check_input
+from sim.effects import _augmented, _starts
+from sim.effects.registry import EFFECTS, EffectError, EffectSpec, check_unique
+from sim.errors import SimulationError
+from sim.params import StandParams
+from sim.results import BatchResult, ModelRun, SimResult
 
 FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.int64]
 
 __all__ = [
+    "DEFAULT_SUBSTEPS",
     "BatchResult",
+    "Model",
+    "ModelRun",
     "ModelStream",
+    "Restarts",
     "SimResult",
     "SimulationError",
-    "simulate",
-    "simulate_batch",
+    "Variant",
 ]
 
-#: RK4 steps per sample interval; 1 at 2 kHz meets the 0.1 % accuracy bound (see tests).
-DEFAULT_SUBSTEPS = 1
+#: Parameter changes of one set of a batch: StandParams field or "<effect>.<param>" → value.
+Variant = Mapping[str, float]
+
+_STAND_FIELDS = frozenset(f.name for f in fields(StandParams))
+#: Effects whose own states the gauges cannot see at a restart: carried between segments.
+_CARRIED = ("fibre_transverse_vibration", "stick_slip_friction", "fibre_pulley_jump")
 
 
-class SimulationError(ValueError):
-    """The model's inputs are unusable (non-finite, too short, bad rate)."""
-
-
-@dataclass(frozen=True)
-class SimResult:
-    """One simulated run at the input's sample times (SI units)."""
-
-    t_s: FloatArray
-    x_m: FloatArray
-    u_m: FloatArray
-    v_m_s: FloatArray
-    force_n: FloatArray
-    preload_tension_n: float
-
-    @property
-    def dynamic_force_n(self) -> FloatArray:
-        """F − T₀, the force the paper plots."""
-        return self.force_n - self.preload_tension_n
-
-    @property
-    def slack(self) -> NDArray[np.bool_]:
-        """Samples at which the fibre carries no tension."""
-        return self.force_n <= 0.0
-
-
-@dataclass(frozen=True)
-class BatchResult:
-    """Many parameter sets on the same time base: arrays of shape (sets, samples)."""
-
-    t_s: FloatArray
-    u_m: FloatArray
-    v_m_s: FloatArray
-    force_n: FloatArray
-
-
-def param_vector(params: StandParams) -> FloatArray:
-    """The kernel's flat parameter row for one StandParams."""
-    row = np.zeros(kernel.N_PARAMS)
-    row[kernel.P_MASS] = params.mass_kg
-    row[kernel.P_PROJ] = params.projection
-    row[kernel.P_STIFF] = params.stiffness_n_m
-    row[kernel.P_DAMP] = params.damping_n_s_m
-    friction_n = params.normal_force_n * params.friction_scale if params.friction else 0.0
-    row[kernel.P_FRICTION_N] = friction_n
-    row[kernel.P_GRAVITY_N] = params.gravity_along_n
-    row[kernel.P_PRELOAD] = params.preload_m
-    row[kernel.P_VREG] = params.friction.v_reg_m_s if params.friction else 1e-3
-    return row
-
-
-def friction_arrays(table: FrictionTable | None) -> tuple[FloatArray, FloatArray]:
-    """PCHIP knots and cubic coefficients (4, segments) of μ(v) for the kernel."""
-    if table is None:
-        return np.array([0.0, 1.0]), np.zeros((4, 1))  # μ ≡ 0
-    pchip = table.pchip()
-    return np.asarray(pchip.x, dtype=np.float64), np.ascontiguousarray(pchip.c, dtype=np.float64)
-
-
-def _check_input(x_m: FloatArray, rate_hz: float) -> FloatArray:
-    x = np.ascontiguousarray(x_m, dtype=np.float64)
-    if x.ndim != 1 or x.shape[0] < 2:
-        raise SimulationError(f"drive position must be a 1-D series of ≥ 2 samples, got {x.shape}")
-    if not np.all(np.isfinite(x)):
-        raise SimulationError("All drive positions must be finite.")
-    if not (np.isfinite(rate_hz) and rate_hz > 0):
-        raise SimulationError(f"sample rate must be > 0 Hz, got {rate_hz}")
-    rel: FloatArray = x - x[0]  # the model starts at rest: x from the first sample
-    return rel
-
-
-def simulate(
-    x_m: FloatArray, rate_hz: float, params: StandParams, substeps: int = DEFAULT_SUBSTEPS
-) -> SimResult:
-    """Simulate the weight and fibre for a drive position series.
-
-    Parameters
-    ----------
-    x_m
-        Drive position, m, downward positive, shape (N,), sampled at ``rate_hz``.
-    rate_hz
-        Sample rate, Hz.
-    params
-        The stand's parameters.
-    substeps
-        RK4 steps per sample interval.
-    """
-    x = _check_input(x_m, rate_hz)
-    n = x.shape[0]
-    u, v, f = np.empty(n), np.empty(n), np.empty(n)
-    knots, coef = friction_arrays(params.friction)
-    kernel.simulate_into(x, 1.0 / rate_hz, substeps, param_vector(params), knots, coef, u, v, f)
-    t = np.arange(n) / rate_hz
-    return SimResult(t, np.asarray(x_m, dtype=np.float64), u, v, f, params.preload_tension_n)
-
-
-def simulate_batch(
-    x_m: FloatArray,
-    rate_hz: float,
-    params: Sequence[StandParams],
-    substeps: int = DEFAULT_SUBSTEPS,
-) -> BatchResult:
-    """Simulate many parameter sets on one drive series, in parallel.
-
-    All sets must share one friction table (its scale may differ per set).
-    """
-    x = _check_input(x_m, rate_hz)
-    tables = {p.friction for p in params if p.friction is not None}
-    if len(tables) > 1:
-        raise SimulationError("a batch must share one friction table (vary friction_scale)")
-    table = next(iter(tables)) if tables else None
-    rows = np.stack([param_vector(p) for p in params])
-    return simulate_rows(x, rate_hz, rows, table, substeps)
-
-
-def simulate_rows(
-    x_rel_m: FloatArray,
-    rate_hz: float,
-    rows: FloatArray,
-    table: FrictionTable | None,
-    substeps: int = DEFAULT_SUBSTEPS,
-) -> BatchResult:
-    """Lowest-level batch entry: kernel parameter rows (see ``param_vector``)."""
-    x2 = np.ascontiguousarray(np.atleast_2d(x_rel_m), dtype=np.float64)
-    sets, n = rows.shape[0], x2.shape[1]
-    u, v, f = np.empty((sets, n)), np.empty((sets, n)), np.empty((sets, n))
-    knots, coef = friction_arrays(table)
-    kernel.simulate_batch_into(
-        x2, 1.0 / rate_hz, substeps, np.ascontiguousarray(rows), knots, coef, u, v, f
-    )
-    return BatchResult(np.arange(n) / rate_hz, u, v, f)
-
-
-class ModelStream:
-    """The baseline model advanced block by block, for a simulated stand in real time.
-
-    Starts at static rest with the drive at ``x0_m``; each ``advance`` takes the drive
-    positions of the next samples and returns the weight displacement and fibre force at
-    them. Results equal one ``simulate`` call over the concatenated blocks.
-    """
-
-    def __init__(
-        self,
-        params: StandParams,
-        rate_hz: float,
-        x0_m: float = 0.0,
-        substeps: int = DEFAULT_SUBSTEPS,
-    ) -> None:
-        self.params = params
-        self.rate_hz = rate_hz
-        self._row = param_vector(params)
-        self._knots, self._coef = friction_arrays(params.friction)
-        self._substeps = substeps
-        self._x0 = x0_m
-        self._last_x = x0_m
-        self._state: tuple[float, float, bool] = (0.0, 0.0, True)
+class ModelStream(Protocol):
+    """The model advanced block by block (the simulated stand's physics)."""
 
     @property
     def velocity_m_s(self) -> float:
         """Weight velocity after the last sample, m/s."""
-        return self._state[1]
+        ...
 
     def advance(self, x_m: FloatArray) -> tuple[FloatArray, FloatArray]:
-        """Weight displacement u (m) and fibre force F (N) at the next len(x_m) samples."""
-        block = np.ascontiguousarray(x_m, dtype=np.float64)
-        if block.ndim != 1 or not np.all(np.isfinite(block)):
-            raise SimulationError("drive positions must be a finite 1-D block")
-        x = np.empty(block.shape[0] + 1)
-        x[0] = self._last_x
-        x[1:] = block
-        x -= self._x0
-        n = x.shape[0]
-        u, v, f = np.empty(n), np.empty(n), np.empty(n)
-        u0, v0, taut0 = self._state
-        self._state = kernel.advance_into(
-            x,
-            1.0 / self.rate_hz,
-            self._substeps,
-            self._row,
-            self._knots,
-            self._coef,
-            u0,
-            v0,
-            taut0,
-            u,
-            v,
-            f,
-        )
-        if block.shape[0]:
-            self._last_x = float(block[-1])
-        return u[1:], f[1:]
+        """Recorded u (m) and F (N) at the next len(x_m) drive positions."""
+        ...
 
 
-def simulate_segment_rows(
-    x_rel_m: FloatArray,
-    rate_hz: float,
-    rows: FloatArray,
-    table: FrictionTable | None,
-    starts: NDArray[np.int64],
-    lengths: NDArray[np.int64],
-    init: FloatArray,
-    substeps: int = DEFAULT_SUBSTEPS,
-) -> tuple[FloatArray, FloatArray]:
-    """Many short runs from given states (multiple shooting), all in one parallel batch.
+@dataclass(frozen=True)
+class Restarts:
+    """Where the runs of a multiple-shooting simulation start, and what was measured.
+
+    Attributes
+    ----------
+    starts, lengths
+        First sample and number of samples of each segment run.
+    u_m, v_m_s, force_n
+        The recorded channels at every sample (smoothed): u (m), its rate (m/s), F (N).
+        A segment starting at sample 0 starts from static rest instead.
+    """
+
+    starts: IntArray
+    lengths: IntArray
+    u_m: FloatArray
+    v_m_s: FloatArray
+    force_n: FloatArray
+
+
+class Model:
+    """The baseline model of STAND.md §2 plus the effects of §5 switched on.
 
     Parameters
     ----------
-    x_rel_m
-        Drive position relative to rest, m, shape (N,).
-    rate_hz
-        Sample rate, Hz.
-    rows
-        Kernel parameter rows (``param_vector``), shape (sets, N_PARAMS).
-    table
-        The friction table all rows share.
-    starts, lengths
-        First sample and number of samples of each segment, shape (segments,).
-    init
-        Start state (u m, v m/s) of each set's segment, shape (sets, segments, 2); a
-        segment starting at sample 0 starts from static rest instead.
+    stand
+        The stand's parameters.
+    effects
+        Effects switched on (each at most once); parameters not given take defaults.
     substeps
-        RK4 steps per sample interval.
+        Least RK4 steps per sample interval (stiff effects take more as needed).
 
-    Returns
-    -------
-    u, force
-        Weight displacement (m) and tension (N), shape (sets, segments, max length);
-        each segment's last value is held to the end of its row.
+    Raises
+    ------
+    EffectError
+        An effect named twice, or a parameter outside its admissible range.
     """
-    rows2 = np.ascontiguousarray(np.atleast_2d(rows), dtype=np.float64)
-    sets, segs, width = rows2.shape[0], starts.shape[0], int(lengths.max())
-    u, f = np.empty((sets, segs, width)), np.empty((sets, segs, width))
-    knots, coef = friction_arrays(table)
-    kernel.simulate_segments_into(
-        np.ascontiguousarray(x_rel_m, dtype=np.float64), 1.0 / rate_hz, substeps, rows2,
-        knots, coef, np.ascontiguousarray(starts, dtype=np.int64),
-        np.ascontiguousarray(lengths, dtype=np.int64),
-        np.ascontiguousarray(init, dtype=np.float64), u, f,
-    )  # fmt: skip
-    return u, f
+
+    def __init__(
+        self,
+        stand: StandParams,
+        effects: Sequence[EffectSpec] = (),
+        substeps: int = DEFAULT_SUBSTEPS,
+    ) -> None:
+        check_unique(effects)
+        for spec in effects:
+            spec.resolved()  # refuses unknown names and values out of range, here
+        self.stand = stand
+        self.effects = tuple(effects)
+        self.substeps = substeps
+        kinds = {EFFECTS[e.name].kind for e in self.effects}
+        #: Physical effects change the dynamics: the augmented kernel runs.
+        self.physical = "physical" in kinds
+        #: Measurement effects transform the outputs.
+        self.measured = "measurement" in kinds
+        self._chained = any(e.name in _CARRIED for e in self.effects)
+
+    def __repr__(self) -> str:
+        names = ", ".join(str(e) for e in self.effects) or "baseline"
+        return f"Model({names}, m = {self.stand.mass_kg:g} kg)"
+
+    # -- parameter sets -------------------------------------------------------------
+    def variant(self, values: Variant) -> Model:
+        """The same model with some parameters changed (see the module docstring for names)."""
+        stand_changes: dict[str, float] = {}
+        effect_changes: dict[str, dict[str, float]] = {}
+        for key, value in values.items():
+            effect, dot, param = key.partition(".")
+            if not dot:
+                if key not in _STAND_FIELDS:
+                    raise SimulationError(f"unknown stand parameter {key!r}")
+                stand_changes[key] = float(value)
+                continue
+            if effect not in {e.name for e in self.effects}:
+                raise EffectError(f"{key}: the model has no effect {effect!r}")
+            effect_changes.setdefault(effect, {})[param] = float(value)
+        effects = [
+            EffectSpec(e.name, {**e.params, **effect_changes.get(e.name, {})}) for e in self.effects
+        ]
+        stand = self.stand.with_(**stand_changes) if stand_changes else self.stand
+        return Model(stand, effects, self.substeps)
+
+    def _rows(
+        self, variants: Sequence[Variant], augmented: bool = False
+    ) -> tuple[FloatArray, FloatArray]:
+        """(baseline kernel rows, augmented rows) of the variants.
+
+        The augmented rows are built only where needed (effects, or ``augmented``); else
+        the baseline rows stand in for them.
+        """
+        models = [self.variant(v) if v else self for v in variants]
+        tables = {m.stand.friction for m in models}
+        if len(tables) > 1:
+            raise SimulationError("a batch must share one friction table (vary friction_scale)")
+        base = np.stack([_baseline.param_vector(m.stand) for m in models])
+        if not (self.physical or self.measured or augmented):
+            return base, base
+        return base, np.stack([_augmented.augmented_row(m.stand, m.effects) for m in models])
+
+    # -- runs -----------------------------------------------------------------------
+    def run(self, x_m: FloatArray, rate_hz: float) -> ModelRun:
+        """One run from static rest over a drive position series (m, downward positive).
+
+        Returns the recorded u and F (after the gauge effects) and the true channels.
+        """
+        if self.effects:
+            return _augmented.simulate_augmented(
+                x_m, rate_hz, self.stand, self.effects, self.substeps
+            )
+        res = _baseline.simulate(x_m, rate_hz, self.stand, self.substeps)
+        return ModelRun(
+            res.t_s, res.x_m, res.u_m, res.v_m_s, res.force_n, res.preload_tension_n,
+            res.u_m, res.force_n, res.force_n, self.substeps,
+        )  # fmt: skip
+
+    def run_batch(
+        self, x_m: FloatArray, rate_hz: float, variants: Sequence[Variant] = ({},)
+    ) -> BatchResult:
+        """Many parameter sets from static rest, in parallel on all cores.
+
+        ``x_m`` is one drive series (N,) shared by all sets or one per set (sets, N).
+        """
+        x = np.asarray(x_m, dtype=np.float64)
+        rel = (
+            check_input(x, rate_hz)
+            if x.ndim == 1
+            else np.stack([check_input(row, rate_hz) for row in x])
+        )
+        if x.ndim == 2 and x.shape[0] not in (1, len(variants)):
+            raise SimulationError(
+                f"drive rows ({x.shape[0]}) must be 1 or one per set ({len(variants)})"
+            )
+        base, rows = self._rows(variants)
+        table = self.stand.friction
+        if self.physical:
+            return _augmented.simulate_augmented_rows(rel, rate_hz, rows, table, self.substeps)
+        res = _baseline.simulate_rows(rel, rate_hz, base, table, self.substeps)
+        if not self.measured:
+            return res
+        u, f = _augmented.measure_outputs(res.u_m, res.force_n, rate_hz, rows)
+        return BatchResult(res.t_s, u, res.v_m_s, f, res.u_m, res.force_n)
+
+    def run_segments(
+        self,
+        x_m: FloatArray,
+        rate_hz: float,
+        restarts: Restarts,
+        variants: Sequence[Variant] = ({},),
+    ) -> tuple[FloatArray, FloatArray]:
+        """Multiple shooting: short runs restarted from measured states, in parallel.
+
+        Returns the recorded u (m) and F (N) of every segment run, shape (sets,
+        segments, longest segment), each segment's last value held past its end.
+        """
+        x_rel = check_input(x_m, rate_hz)
+        base, rows = self._rows(variants, augmented=True)  # the start states need them
+        init = _starts.start_states(
+            rows, x_rel, rate_hz, restarts.starts, restarts.u_m, restarts.v_m_s,
+            restarts.force_n,
+        )  # fmt: skip
+        table = self.stand.friction
+        starts, lengths = restarts.starts, restarts.lengths
+        if self.physical:
+            return _augmented.simulate_augmented_segments(
+                x_rel, rate_hz, rows, table, starts, lengths, init, self.substeps,
+                chained=self._chained,
+            )  # fmt: skip
+        u, f = _baseline.simulate_segment_rows(
+            x_rel, rate_hz, base, table, starts, lengths, init[:, :, :2], self.substeps
+        )
+        if self.measured:
+            return _augmented.measure_segments(u, f, rate_hz, rows)
+        return u, f
+
+    def stream(self, rate_hz: float, x0_m: float = 0.0) -> ModelStream:
+        """The model at static rest with the drive at ``x0_m``, advanced block by block.
+
+        Equal to one ``run`` over the concatenated blocks. A stream cannot look ahead, so
+        a negative channel skew (a channel recorded early) is refused.
+        """
+        if self.effects:
+            return _augmented.AugmentedStream(
+                self.stand, rate_hz, self.effects, x0_m, self.substeps
+            )
+        return _baseline.BaselineStream(self.stand, rate_hz, x0_m, self.substeps)
+
+    def warm_up(self) -> None:
+        """Compile the kernels this model uses (numba), so a real-time start is not late."""
+        self.stream(2000.0).advance(np.zeros(2))

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from sim.model import simulate
+from sim.model import Model
 from sim.params import StandParams
 
 __all__ = ["Divergence", "nearby_run_divergence"]
@@ -50,8 +50,8 @@ def nearby_run_divergence(
     epsilon: float = 1e-9,
 ) -> Divergence:
     """Run twice, stiffness perturbed by ``epsilon`` (relative); see Divergence."""
-    a = simulate(x_m, rate_hz, params)
-    b = simulate(x_m, rate_hz, params.with_(stiffness_n_m=params.stiffness_n_m * (1 + epsilon)))
+    a = Model(params).run(x_m, rate_hz)
+    b = Model(params.with_(stiffness_n_m=params.stiffness_n_m * (1 + epsilon))).run(x_m, rate_hz)
     diff = np.maximum.accumulate(np.abs(a.u_m - b.u_m))
     first = diff[min(int(first_cycle_end_s * rate_hz), diff.size - 1)]
     floor = epsilon * params.preload_m * 1e-3  # below this the difference is rounding

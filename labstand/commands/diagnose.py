@@ -3,15 +3,19 @@
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import sys
 from pathlib import Path
 
+import numpy as np
+import pandas as pd
+
 from labstand.diagnosis_report import write_report
 from labstand.errors import CommandError, ExitCode
 from recordings import RecordingError, open_recording
-from recordings.diagnosis import DiagnosisInputError, diagnose, make_trace
 from sim.config import ConfigError, config_from_dict, load_config
+from sim.identify import Diagnosis, DiagnosisInputError, Trace, diagnose, make_trace
 
 
 def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -50,6 +54,21 @@ def _mass_of(path: Path, stored: object, override: float | None, fallback: float
         return fallback
 
 
+def trace_of(name: str, frame: pd.DataFrame, mass_kg: float) -> Trace:
+    """A recording's frame (t_s index, x_mm, u_mm, F_N) as a diagnosis trace (SI units)."""
+    for column in ("x_mm", "u_mm", "F_N"):
+        if column not in frame.columns:
+            raise DiagnosisInputError(f"{name}: the recording has no {column} channel")
+    return make_trace(
+        name,
+        np.asarray(frame.index, dtype=np.float64),
+        frame["x_mm"].to_numpy(dtype=np.float64) * 1e-3,
+        frame["u_mm"].to_numpy(dtype=np.float64) * 1e-3,
+        frame["F_N"].to_numpy(dtype=np.float64),
+        mass_kg,
+    )
+
+
 def run(args: argparse.Namespace) -> int:
     """Read, diagnose, report."""
     config = load_config(args.stand)
@@ -61,48 +80,43 @@ def run(args: argparse.Namespace) -> int:
         try:
             rec = open_recording(path)
             mass = _mass_of(path, rec.metadata.stand_config, args.mass_kg, config.default_mass_kg)
-            traces.append(make_trace(path.name, rec.frame(), mass))
+            traces.append(trace_of(path.name, rec.frame(), mass))
         except (RecordingError, DiagnosisInputError) as err:
             raise CommandError(str(err), ExitCode.USAGE) from None
     names = [t.name for t in traces]
     if len(set(names)) != len(names):
-        traces = [
-            t.__class__(**{**t.__dict__, "name": f"{i}:{t.name}"}) for i, t in enumerate(traces)
-        ]
+        traces = [dataclasses.replace(t, name=f"{i}:{t.name}") for i, t in enumerate(traces)]
 
     def progress(message: str) -> None:
         print(f"labstand diagnose: {message}", file=sys.stderr, flush=True)
 
     result = diagnose(traces, nominal, progress=progress)
-    out = result.to_dict()
-    out["recordings"] = [str(p) for p in args.recordings]
-    if args.report is not None:
-        index = write_report(args.report, traces, result)
-        out["report"] = str(index)
+    index = write_report(args.report, traces, result) if args.report is not None else None
     if args.json:
+        out = result.to_dict()
+        out["recordings"] = [str(p) for p in args.recordings]
+        if index is not None:
+            out["report"] = str(index)
         print(json.dumps(out, indent=2))
         return 0
-    _print_summary(out)
+    _print_summary(result, index)
     return 0
 
 
-def _print_summary(out: dict[str, object]) -> None:
-    effect = out["effect"]
-    print(f"Effect: {effect}")
-    before, after = out["gap_before"], out["gap_after"]
+def _print_summary(result: Diagnosis, report: Path | None) -> None:
+    print(f"Effect: {result.effect}")
     print("Held-out gap        before            after")
     for ch in ("u", "F"):
-        b, a = before[ch], after[ch]  # type: ignore[index]
+        b, a = result.gap_before[ch], result.gap_after[ch]
         print(
-            f"  {ch}: NRMSE {b['nrmse']:.4f}  R {b['R']:.5f}"
-            f"   NRMSE {a['nrmse']:.4f}  R {a['R']:.5f}"
+            f"  {ch}: NRMSE {b['nrmse']:.4f}  R {b['R']:.6f}"
+            f"   NRMSE {a['nrmse']:.4f}  R {a['R']:.6f}"
         )
     print("Ranking (score = held-out gap closure; screening = share of residual explained):")
-    for r in out["ranking"][:5]:  # type: ignore[index]
-        score = "   —  " if r["score"] is None else f"{r['score']:6.3f}"
-        print(f"  {r['effect']:28s} score {score}  screening {r['screening']:.3f}")
-    where = out["where"]
+    for r in result.ranking[:5]:
+        score = "   —  " if r.score is None else f"{r.score:6.3f}"
+        print(f"  {r.effect:28s} score {score}  screening {r.screening:.3f}")
     print("Where (share of the baseline's residual):")
-    print("  channel: " + ", ".join(f"{k} {v:.0%}" for k, v in where["channel"].items()))  # type: ignore[index]
-    if "report" in out:
-        print(f"Report: {out['report']}")
+    print("  channel: " + ", ".join(f"{k} {v:.0%}" for k, v in result.where.channel.items()))
+    if report is not None:
+        print(f"Report: {report}")

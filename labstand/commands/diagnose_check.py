@@ -8,7 +8,7 @@ import sys
 from pathlib import Path
 
 from labstand.commands.common import add_stand_options, load_stand
-from recordings.diagnosis.check import CLASSES, FULL_CAMPAIGN, MASSES_KG, SMALL_CAMPAIGN, run_check
+from sim.identify.check import CLASSES, FULL_CAMPAIGN, MASSES_KG, SMALL_CAMPAIGN, run_check
 
 
 def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:

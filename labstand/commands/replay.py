@@ -10,8 +10,8 @@ from pathlib import Path
 from labstand.plots import plot_replay
 from labstand.recording_stand import params_for
 from recordings import open_recording
-from recordings.metrics import ChannelMetrics
 from recordings.replay import replay
+from sim.metrics import ChannelMetrics
 
 
 def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:

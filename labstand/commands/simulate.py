@@ -17,9 +17,9 @@ from labstand.commands.common import add_stand_options, load_stand
 from labstand.errors import CommandError, ExitCode
 from labstand.output import write_simulation
 from sim.config import StandConfig
-from sim.effects import EffectSpec, parse_effects, simulate_augmented
+from sim.effects import EffectSpec, parse_effects
 from sim.effects.realism import NoiseSpec, add_measurement_noise
-from sim.model import SimResult, simulate
+from sim.model import Model, SimResult
 from sim.params import StandParams
 from sim.situations import SITUATIONS, situation
 
@@ -130,7 +130,7 @@ def run(args: argparse.Namespace) -> int:
     if effects or args.noise:
         result, truth = _simulate_real_like(x_m, config.sample_rate_hz, params, effects, args)
     else:
-        result = truth = simulate(x_m, config.sample_rate_hz, params)
+        result = truth = Model(params).run(x_m, config.sample_rate_hz)
     elapsed = time.perf_counter() - started
     summary = summarise(truth, profile, mass)
     if effects or args.noise:
@@ -165,7 +165,7 @@ def _simulate_real_like(
 
     Returns the recorded-like run and the true one (for the summary's slack figures).
     """
-    run = simulate_augmented(x_m, rate_hz, params, effects)
+    run = Model(params, effects).run(x_m, rate_hz)
     truth = replace(run, u_m=run.true_u_m, force_n=run.true_force_n)
     result: SimResult = run
     if args.noise:

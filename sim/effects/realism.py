@@ -19,8 +19,8 @@ from dataclasses import dataclass, replace
 import numpy as np
 from numpy.typing import NDArray
 
-from sim.model import SimResult
 from sim.params import StandParams
+from sim.results import SimResult
 
 FloatArray = NDArray[np.float64]
 

@@ -21,7 +21,7 @@ from typing import Literal
 import numpy as np
 
 from sim.effects import kernel as ek
-from sim.model import SimulationError
+from sim.errors import SimulationError
 
 __all__ = [
     "EFFECTS",

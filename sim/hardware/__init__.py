@@ -29,7 +29,7 @@ from sim.hardware.stand import (
     StandSettings,
     StandThread,
 )
-from sim.hardware.stand_model import available_effects, build_stand_model, register_effect
+from sim.hardware.stand_model import available_effects, build_stand_model
 
 __all__ = [
     "Clock",
@@ -49,5 +49,4 @@ __all__ = [
     "available_effects",
     "build_stand_model",
     "parse_fault",
-    "register_effect",
 ]

@@ -1,7 +1,7 @@
 """The simulated gauge front end: 2 kHz binary frames computed from the stand model.
 
 For every sample the front end takes the simulated drive's position x, advances the
-stand model (``StandModel``: the baseline ``sim.model.ModelStream`` or a model with
+stand model (``StandModel``: the baseline ``sim.model.Model`` or a model with
 effects switched on), adds gauge noise, quantises to counts with the stand's calibration
 and encodes ``drivers.gauge_frame`` frames with its own sequence counter and µs clock.
 

@@ -41,7 +41,7 @@ from sim.hardware.modbus_server import make_device, start_rtu_server, start_tcp_
 from sim.hardware.pty import PtyBridge, RawPty, open_raw_pty
 from sim.hardware.servo import ServoSettings
 from sim.hardware.stand_model import build_stand_model
-from sim.model import ModelStream
+from sim.model import Model
 from sim.params import StandParams
 
 log = logging.getLogger(__name__)
@@ -178,7 +178,7 @@ class SimulatedStand:
     async def start(self) -> Endpoints:
         """Open the ptys, start the Modbus server; returns where to connect."""
         # Compile the model's kernel now, not in the first Modbus request's time-out.
-        ModelStream(self._params, self.drive.rate_hz).advance(np.zeros(2))
+        Model(self._params).stream(self.drive.rate_hz).advance(np.zeros(2))
         try:
             self._gauge_pty = open_raw_pty()
             self.writer = PtyWriter(self._gauge_pty.master_fd)

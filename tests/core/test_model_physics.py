@@ -9,7 +9,7 @@ import pytest
 
 from drivers.signals import Shape, SignalSpec, plan_motion
 from sim.config import StandConfig
-from sim.model import ModelStream, SimulationError, simulate, simulate_batch
+from sim.model import Model, SimulationError
 from sim.modes import linear_modes
 from sim.params import StandParams
 from sim.reference import solve_reference
@@ -33,7 +33,7 @@ def _situation_run(stand: StandConfig, name: str, params: str = "final"):
 @pytest.mark.parametrize("mass_kg", [3.096, 8.131])
 def test_static_rest_stays_at_rest(stand: StandConfig, params: str, mass_kg: float) -> None:
     p = stand.stand_params(params, mass_kg)
-    run = simulate(np.zeros(20_000), RATE, p)
+    run = Model(p).run(np.zeros(20_000), RATE)
     assert np.abs(run.u_m).max() < 1e-12
     assert np.allclose(run.force_n, p.preload_tension_n, rtol=1e-12)
     # T₀ = m·g·sin α / n, by hand for the default geometry:
@@ -47,7 +47,7 @@ def test_force_balance_while_sliding_steadily(stand: StandConfig, direction: flo
     drive_speed = 0.02  # m/s, a slow constant pull (or release)
     t = np.arange(int(8 * RATE)) / RATE
     x = direction * drive_speed * t
-    run = simulate(x, RATE, p)
+    run = Model(p).run(x, RATE)
     steady = t > 6.0  # the 9 Hz ringing from the start has decayed (τ ≈ 0.7 s)
     v = direction * drive_speed / p.projection
     # A whole number of ringing periods averages the last of the 9 Hz ringing away.
@@ -64,7 +64,7 @@ def test_force_balance_while_sliding_steadily(stand: StandConfig, direction: flo
 @pytest.mark.parametrize("params", ["starting", "final"])
 def test_tension_is_never_negative(stand: StandConfig, name: str, params: str) -> None:
     x, p = _situation_run(stand, name, params)
-    run = simulate(x, RATE, p)
+    run = Model(p).run(x, RATE)
     assert run.force_n.min() >= 0.0
     assert np.all(np.isfinite(run.u_m))
 
@@ -76,7 +76,7 @@ def test_slack_in_quick_heavy_situations_only(
     stand: StandConfig, name: str, slack_expected: bool
 ) -> None:
     x, p = _situation_run(stand, name)
-    run = simulate(x, RATE, p)
+    run = Model(p).run(x, RATE)
     assert bool(run.slack.any()) is slack_expected
     if slack_expected:
         # Briefly: the weight stays on the stand, within 1.5× the stroke.
@@ -96,16 +96,16 @@ def test_agrees_with_the_reference_solution_within_0_1_percent(
     _, x = plan_motion(spec, stand.drive).sample(RATE)
     p = stand.stand_params("final", s.mass_kg)
     ref = solve_reference(x, RATE, p, method="DOP853", rtol=1e-10, atol=1e-13)
-    run = simulate(x, RATE, p)
+    run = Model(p).run(x, RATE)
     assert _nrmse(run.u_m, ref.u_m) < 1e-3
     assert _nrmse(run.force_n, ref.force_n) < 1e-3
 
 
 def test_the_slack_to_taut_jump_does_not_cost_the_integrator_its_order(stand: StandConfig) -> None:
     x, p = _situation_run(stand, "10")
-    assert simulate(x, RATE, p).slack.any()
-    truth = simulate(x, RATE, p, substeps=64).force_n
-    errors = [_nrmse(simulate(x, RATE, p, substeps=k).force_n, truth) for k in (2, 4)]
+    assert Model(p).run(x, RATE).slack.any()
+    truth = Model(p, substeps=64).run(x, RATE).force_n
+    errors = [_nrmse(Model(p, substeps=k).run(x, RATE).force_n, truth) for k in (2, 4)]
     # Fourth order: halving the step divides the error by ≈ 16 (first order would give 2).
     assert errors[0] / errors[1] > 8
 
@@ -125,7 +125,7 @@ def test_free_ringing_in_the_simulation_has_the_linearised_frequency(stand: Stan
     # A small, quick 0.1 mm drive step rings the weight without slackening the fibre.
     x = np.zeros(int(4 * RATE))
     x[100:] = 1e-4
-    run = simulate(x, RATE, p)
+    run = Model(p).run(x, RATE)
     assert not run.slack.any()
     signal = run.u_m[200:] - run.u_m[-1]
     spectrum = np.abs(np.fft.rfft(signal * np.hanning(signal.size), n=1 << 18))
@@ -136,17 +136,17 @@ def test_free_ringing_in_the_simulation_has_the_linearised_frequency(stand: Stan
 def test_batch_and_stream_equal_single_runs(stand: StandConfig) -> None:
     x, p = _situation_run(stand, "11")
     sets = [
-        p.with_(stiffness_n_m=k, damping_n_s_m=c)
+        {"stiffness_n_m": k, "damping_n_s_m": c}
         for k, c in ((30e3, 20.0), (34e3, 27.5), (40e3, 35.0))
     ]
-    batch = simulate_batch(x, RATE, sets)
+    batch = Model(p).run_batch(x, RATE, sets)
     for i, q in enumerate(sets):
-        single = simulate(x, RATE, q)
+        single = Model(p.with_(**q)).run(x, RATE)
         assert np.array_equal(batch.u_m[i], single.u_m)
         assert np.array_equal(batch.force_n[i], single.force_n)
-    stream = ModelStream(p, RATE, x0_m=float(x[0]))
+    stream = Model(p).stream(RATE, x0_m=float(x[0]))
     parts = [stream.advance(x[i : i + 97]) for i in range(1, x.size, 97)]
-    single = simulate(x, RATE, p)
+    single = Model(p).run(x, RATE)
     assert np.array_equal(np.concatenate([u for u, _ in parts]), single.u_m[1:])
     assert np.array_equal(np.concatenate([f for _, f in parts]), single.force_n[1:])
 
@@ -173,4 +173,4 @@ def test_violent_runs_amplify_tiny_differences_and_paper_runs_do_not(stand: Stan
 def test_unusable_input_is_refused(x: np.ndarray, rate: float, message: str) -> None:
     p = StandParams(mass_kg=8.131, stiffness_n_m=34e3, damping_n_s_m=27.5)
     with pytest.raises(SimulationError, match=message):
-        simulate(x, rate, p)
+        Model(p).run(x, rate)

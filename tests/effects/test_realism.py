@@ -11,14 +11,14 @@ from sim.effects import (
     NoiseSpec,
     add_measurement_noise,
     draw_real_stand,
-    simulate_augmented,
 )
+from sim.model import Model
 from tests.effects.helpers import RATE, situation_drive
 
 
 def test_noise_levels_hum_and_quantisation(stand: StandConfig) -> None:
     p = stand.stand_params("final")
-    truth = simulate_augmented(np.zeros(40_000), RATE, p)  # 20 s at rest
+    truth = Model(p).run(np.zeros(40_000), RATE)  # 20 s at rest
     spec = NoiseSpec(force_rms_n=0.1, displacement_rms_m=5e-6, hum_force_n=0.05)
     rec = add_measurement_noise(truth, np.random.default_rng(1), spec)
     du, df = rec.u_m - truth.u_m, rec.force_n - truth.force_n
@@ -38,7 +38,7 @@ def test_noise_levels_hum_and_quantisation(stand: StandConfig) -> None:
 
 def test_noise_is_seeded_and_block_invariant(stand: StandConfig) -> None:
     x, mass = situation_drive(stand, "11")
-    truth = simulate_augmented(x, RATE, stand.stand_params("final", mass))
+    truth = Model(stand.stand_params("final", mass)).run(x, RATE)
     one = add_measurement_noise(truth, np.random.default_rng(9))
     again = add_measurement_noise(truth, np.random.default_rng(9))
     assert np.array_equal(one.force_n, again.force_n) and np.array_equal(one.u_m, again.u_m)

@@ -10,8 +10,8 @@ import pytest
 
 from drivers.signals import Shape, SignalSpec
 from sim.config import StandConfig
-from sim.effects import AugmentedResult, EffectSpec, simulate_augmented
-from sim.model import SimResult, simulate
+from sim.effects import EffectSpec
+from sim.model import Model, ModelRun, SimResult
 from sim.params import StandParams
 from tests.effects.helpers import (
     RATE,
@@ -27,10 +27,10 @@ HEAVY, LIGHT = 8.131, 3.096
 
 def _pair(
     stand: StandConfig, x: np.ndarray, mass: float, spec: EffectSpec, params: str = "final"
-) -> tuple[StandParams, SimResult, AugmentedResult]:
+) -> tuple[StandParams, SimResult, ModelRun]:
     """The stand, its baseline run and its run with one effect."""
     p = stand.stand_params(params, mass)
-    return p, simulate(x, RATE, p), simulate_augmented(x, RATE, p, [spec])
+    return p, Model(p).run(x, RATE), Model(p, [spec]).run(x, RATE)
 
 
 # --- measurement effects -------------------------------------------------------------
@@ -115,9 +115,9 @@ def test_string_modes_ring_at_the_predicted_tension_dependent_frequency(
     stand: StandConfig, mass: float
 ) -> None:
     # Free vibration about rest (weakly damped, drive held): the kernel's own state is set.
+    from sim._baseline import friction_arrays
     from sim.effects import kernel
-    from sim.effects.simulator import augmented_row
-    from sim.model import friction_arrays
+    from sim.effects._augmented import augmented_row
 
     p = stand.stand_params("starting", mass)
     spec = EffectSpec("fibre_transverse_vibration", {"damping_ratio": 1e-4})
@@ -242,8 +242,8 @@ def test_side_load_friction_balance_while_sliding_steadily(
     p = stand.stand_params("final", HEAVY)
     t = np.arange(int(8 * RATE)) / RATE
     mu = 0.1
-    run = simulate_augmented(
-        direction * 0.02 * t, RATE, p, [EffectSpec("side_load_friction", {"friction_coeff": mu})]
+    run = Model(p, [EffectSpec("side_load_friction", {"friction_coeff": mu})]).run(
+        direction * 0.02 * t, RATE
     )
     steady = t > 6.0
     v = direction * 0.02 / p.projection
@@ -279,8 +279,8 @@ def test_stick_slip_breaks_away_at_static_friction(stand: StandConfig) -> None:
     p = stand.stand_params("final", HEAVY)
     t = np.arange(int(1.0 * RATE)) / RATE
     x = 0.002 * t  # a slow pull from rest
-    base = simulate(x, RATE, p)
-    run = simulate_augmented(x, RATE, p, [EffectSpec("stick_slip_friction", {"static_ratio": 0.4})])
+    base = Model(p).run(x, RATE)
+    run = Model(p, [EffectSpec("stick_slip_friction", {"static_ratio": 0.4})]).run(x, RATE)
     kinetic = p.normal_force_n * p.friction.mu[0]  # type: ignore[union-attr]
     n = p.projection
     assert run.force_n.max() == pytest.approx((p.gravity_along_n + 1.4 * kinetic) / n, rel=0.01)
@@ -294,8 +294,8 @@ def test_stick_slip_shows_at_low_speed_not_in_fast_sliding(stand: StandConfig) -
     spreads = {}
     for speed in (0.002, 0.05):
         x = speed * t
-        base = simulate(x, RATE, p)
-        run = simulate_augmented(x, RATE, p, [EffectSpec("stick_slip_friction")])
+        base = Model(p).run(x, RATE)
+        run = Model(p, [EffectSpec("stick_slip_friction")]).run(x, RATE)
         spreads[speed] = (np.std(run.force_n[late]), np.std(base.force_n[late]))
         if speed == 0.05:  # LuGre's steady sliding friction is the table's
             assert run.force_n[late].mean() == pytest.approx(base.force_n[late].mean(), rel=2e-3)

@@ -7,18 +7,9 @@ import numpy as np
 import pytest
 
 from sim.config import StandConfig
-from sim.effects import (
-    EFFECTS,
-    AugmentedStream,
-    EffectError,
-    EffectSpec,
-    augmented_row,
-    param_column,
-    simulate_augmented,
-    simulate_augmented_batch,
-    simulate_augmented_rows,
-)
-from sim.model import simulate
+from sim.effects import EFFECTS, EffectError, EffectSpec
+from sim.effects._augmented import AugmentedStream, simulate_augmented
+from sim.model import Model
 from sim.situations import SITUATIONS
 from tests.effects.helpers import RATE, situation_drive
 
@@ -47,8 +38,8 @@ def test_all_effects_off_reproduces_the_baseline(
 ) -> None:
     x, mass = situation_drive(stand, name)
     p = stand.stand_params(params, mass)
-    base = simulate(x, RATE, p)
-    run = simulate_augmented(x, RATE, p)
+    base = Model(p).run(x, RATE)  # the front door runs the baseline's own kernel
+    run = simulate_augmented(x, RATE, p)  # the augmented kernel, every effect off
     assert _rel(run.u_m, base.u_m) <= 1e-9
     assert _rel(run.v_m_s, base.v_m_s) <= 1e-9
     assert _rel(run.force_n, base.force_n) <= 1e-9
@@ -59,10 +50,10 @@ def test_all_effects_off_reproduces_the_baseline(
 def test_zero_magnitudes_reproduce_the_baseline(stand: StandConfig, name: str) -> None:
     x, mass = situation_drive(stand, name)
     p = stand.stand_params("final", mass)
-    base = simulate(x, RATE, p)
+    base = Model(p).run(x, RATE)
     for spec in [*ZERO_MAGNITUDE, None]:
         effects = ZERO_MAGNITUDE if spec is None else [spec]  # each alone, then all together
-        run = simulate_augmented(x, RATE, p, effects)
+        run = Model(p, effects).run(x, RATE)
         assert _rel(run.u_m, base.u_m) <= 1e-9, spec
         assert _rel(run.force_n, base.force_n) <= 1e-9, spec
 
@@ -72,12 +63,12 @@ def test_massless_frictionless_pulley_tends_to_the_baseline(stand: StandConfig) 
     # with J → 0 and no bearing friction it must be the single fibre again.
     x, mass = situation_drive(stand, "10")
     p = stand.stand_params("final", mass)
-    base = simulate(x, RATE, p)
+    base = Model(p).run(x, RATE)
     light = EffectSpec(
         "pulley_inertia_friction",
         {"inertia_kg_m2": 1e-6, "bearing_torque_n_m": 0.0, "load_coeff": 0.0},
     )
-    run = simulate_augmented(x, RATE, p, [light])
+    run = Model(p, [light]).run(x, RATE)
     span = np.ptp(base.force_n)
     assert np.abs(run.force_n - base.force_n).max() < 0.01 * span
     assert np.abs(run.u_m - base.u_m).max() < 0.01 * np.ptp(base.u_m)
@@ -89,7 +80,7 @@ def test_static_rest_stays_at_rest_with_every_effect(
     stand: StandConfig, mass_kg: float, params: str
 ) -> None:
     p = stand.stand_params(params, mass_kg)
-    run = simulate_augmented(np.zeros(4000), RATE, p, ALL)
+    run = Model(p, ALL).run(np.zeros(4000), RATE)
     assert np.abs(run.u_m).max() < 1e-12
     assert np.abs(run.true_u_m).max() < 1e-12
     assert np.allclose(run.force_n, p.preload_tension_n, rtol=1e-10)
@@ -100,37 +91,46 @@ def test_static_rest_stays_at_rest_with_every_effect(
 def test_batch_equals_single_runs_with_mixed_effects(stand: StandConfig) -> None:
     x, mass = situation_drive(stand, "10")
     p = stand.stand_params("final", mass)
-    sets = [
-        (p, []),
-        (p.with_(stiffness_n_m=30e3), [EffectSpec("fibre_viscoelastic")]),
-        (p.with_(friction_scale=0.8), [EffectSpec("pulley_inertia_friction")]),
-        (p, ALL),
+    model = Model(p, ALL)
+    variants = [
+        {},
+        {"stiffness_n_m": 30e3, "fibre_viscoelastic.relaxation_time_s": 0.01},
+        {"friction_scale": 0.8, "pulley_inertia_friction.inertia_kg_m2": 5e-5},
     ]
-    batch = simulate_augmented_batch(x, RATE, sets)
-    for i, (stand_i, effects) in enumerate(sets):
-        one = simulate_augmented(x, RATE, stand_i, effects)
+    batch = model.run_batch(x, RATE, variants)
+    for i, variant in enumerate(variants):
+        one = model.variant(variant).run(x, RATE)
         assert np.array_equal(batch.u_m[i], one.u_m)
         assert np.array_equal(batch.force_n[i], one.force_n)
         assert np.array_equal(batch.true_force_n[i], one.true_force_n)
+    # Without physical effects the batch runs on the baseline's kernel, gauge effects after.
+    gauge = Model(p, [EffectSpec("force_gauge_dynamics")])
+    batch = gauge.run_batch(x, RATE, [{}, {"force_gauge_dynamics.cutoff_hz": 50.0}])
+    for i, variant in enumerate([{}, {"force_gauge_dynamics.cutoff_hz": 50.0}]):
+        one = gauge.variant(variant).run(x, RATE)
+        assert np.allclose(batch.force_n[i], one.force_n, rtol=0, atol=1e-9)
+        assert np.allclose(batch.true_force_n[i], one.true_force_n, rtol=0, atol=1e-9)
 
 
-def test_rows_can_be_varied_by_column(stand: StandConfig) -> None:
+def test_variants_change_parameters_by_name(stand: StandConfig) -> None:
     x, mass = situation_drive(stand, "10")
     p = stand.stand_params("final", mass)
-    row = augmented_row(p, [EffectSpec("dial_gauge_calibration")])
-    rows = np.stack([row, row])
-    rows[1, param_column("dial_gauge_calibration", "gain_error")] = -0.03
-    res = simulate_augmented_rows(x - x[0], RATE, rows, p.friction)
+    model = Model(p, [EffectSpec("dial_gauge_calibration")])
+    res = model.run_batch(x, RATE, [{}, {"dial_gauge_calibration.gain_error": -0.03}])
     assert np.allclose(res.u_m[1], 0.97 * res.true_u_m[1], rtol=0, atol=1e-15)
     assert np.allclose(res.u_m[0], 1.02 * res.true_u_m[0], rtol=0, atol=1e-15)
+    with pytest.raises(EffectError, match="has no effect 'fibre_viscoelastic'"):
+        model.variant({"fibre_viscoelastic.relaxation_time_s": 0.01})
+    with pytest.raises(EffectError, match="outside its admissible range"):
+        model.variant({"dial_gauge_calibration.gain_error": 3.0})
 
 
 def test_stream_equals_one_run_over_the_blocks(stand: StandConfig) -> None:
     x, mass = situation_drive(stand, "11")
     p = stand.stand_params("final", mass)
     effects = [*ALL[:-2], EffectSpec("channel_time_skew", {"displacement_skew_s": 0.7e-3}), ALL[-1]]
-    offline = simulate_augmented(x, RATE, p, effects)
-    stream = AugmentedStream(p, RATE, effects, x0_m=float(x[0]))
+    offline = Model(p, effects).run(x, RATE)
+    stream = Model(p, effects).stream(RATE, x0_m=float(x[0]))
     rng = np.random.default_rng(5)
     cuts = np.sort(rng.choice(np.arange(1, x.shape[0] - 1), size=40, replace=False))
     parts = [stream.advance(block) for block in np.split(x[1:], cuts)]
@@ -143,7 +143,7 @@ def test_stream_equals_one_run_over_the_blocks(stand: StandConfig) -> None:
 def test_stream_refuses_to_record_a_channel_early(stand: StandConfig) -> None:
     skew = EffectSpec("channel_time_skew", {"force_skew_s": -1e-3})
     with pytest.raises(EffectError, match="negative skew"):
-        AugmentedStream(stand.stand_params("final"), RATE, [skew])
+        Model(stand.stand_params("final"), [skew]).stream(RATE)
 
 
 @pytest.mark.parametrize("name", ["10", "12a"])
@@ -151,8 +151,8 @@ def test_physical_effects_converge_with_the_step(stand: StandConfig, name: str) 
     # Every physical effect on at once; eight times the substeps changes little.
     x, mass = situation_drive(stand, name)
     p = stand.stand_params("final", mass)
-    coarse = simulate_augmented(x, RATE, p, PHYSICAL)
-    fine = simulate_augmented(x, RATE, p, PHYSICAL, substeps=8)
+    coarse = Model(p, PHYSICAL).run(x, RATE)
+    fine = Model(p, PHYSICAL, substeps=8).run(x, RATE)
     for a, b in ((coarse.u_m, fine.u_m), (coarse.force_n, fine.force_n)):
         assert np.linalg.norm(a - b) / np.linalg.norm(b - b.mean()) < 2e-3
 
@@ -160,7 +160,7 @@ def test_physical_effects_converge_with_the_step(stand: StandConfig, name: str) 
 def test_effects_given_twice_are_refused(stand: StandConfig) -> None:
     twice = [EffectSpec("fibre_viscoelastic"), EffectSpec("fibre_viscoelastic")]
     with pytest.raises(EffectError, match="given twice"):
-        simulate_augmented(np.zeros(10), RATE, stand.stand_params("final"), twice)
+        Model(stand.stand_params("final"), twice)
 
 
 def test_the_simulated_stand_switches_effects_on_by_name(stand: StandConfig) -> None:
@@ -173,7 +173,7 @@ def test_the_simulated_stand_switches_effects_on_by_name(stand: StandConfig) -> 
     assert [e.name for e in model.effects] == ["fibre_viscoelastic", "channel_time_skew"]
     x, _ = situation_drive(stand, "10")
     _, f = model.advance(x[1:] - x[0])
-    offline = simulate_augmented(x - x[0], RATE, p, list(model.effects))
+    offline = Model(p, list(model.effects)).run(x - x[0], RATE)
     assert np.allclose(f, offline.force_n[1:], rtol=0, atol=1e-9)
 
 

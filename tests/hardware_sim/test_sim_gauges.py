@@ -17,7 +17,7 @@ from drivers.unidrive import open_unidrive
 from drivers.unidrive_profile import ProfileState
 from sim.config import StandConfig
 from sim.hardware.gauges import FrontEndSettings
-from sim.model import simulate
+from sim.model import Model
 from tests.hardware_sim.conftest import run_stand
 
 
@@ -151,7 +151,7 @@ def test_gauges_follow_the_drive_through_the_model(config: StandConfig) -> None:
     # u and F are the stand model driven by the x the drive really ran (it started at rest)
     params = config.stand_params("final")
     x_m = s["x_mm"] / 1e3
-    ref = simulate(x_m, 2000.0, params)
+    ref = Model(params).run(x_m, 2000.0)
     assert np.sqrt(np.mean((s["u_mm"] - ref.u_m * 1e3) ** 2)) < 0.005  # noise 0.5 µm
     assert np.sqrt(np.mean((s["force_n"] - ref.force_n) ** 2)) < 0.1  # noise 0.02 N
     assert s["force_n"].max() > params.preload_tension_n + 10

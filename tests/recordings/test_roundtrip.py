@@ -18,7 +18,7 @@ from drivers.signals import plan_motion
 from labstand.cli import main
 from recordings import Backend, open_recording, open_writer
 from sim.config import config_from_dict, default_config
-from sim.model import simulate
+from sim.model import Model
 from sim.situations import situation
 
 from .conftest import command, drive, gauges
@@ -44,7 +44,7 @@ def test_simulate_mcap_hdf5_mcap_dataframe_is_lossless(simulated_mcap: Path, tmp
     config = default_config()
     preset = situation("11")
     _, x_m = plan_motion(preset.signal, config.drive).sample(2000.0)
-    result = simulate(x_m, 2000.0, config.stand_params("final", preset.mass_kg))
+    result = Model(config.stand_params("final", preset.mass_kg)).run(x_m, 2000.0)
     df = last.frame()
     n = len(x_m)
     assert df.index.name == "t_s" and len(df) == n

@@ -10,9 +10,9 @@ import pandas as pd
 import pytest
 
 from labstand.cli import main
-from recordings.metrics import channel_metrics, correlation, nrmse
 from recordings.replay import ReplayError, align, compare_runs, replay
 from sim.config import StandConfig
+from sim.metrics import channel_metrics, correlation, nrmse
 
 
 def test_metrics_follow_the_papers_definitions() -> None:
@@ -29,12 +29,12 @@ def test_metrics_follow_the_papers_definitions() -> None:
 
 def _frame(stand: StandConfig, params: str = "final", situation: str = "11") -> pd.DataFrame:
     from drivers.signals import plan_motion
-    from sim.model import simulate
+    from sim.model import Model
     from sim.situations import SITUATIONS
 
     s = SITUATIONS[situation]
     t, x = plan_motion(s.signal, stand.drive).sample(2000.0)
-    run = simulate(x, 2000.0, stand.stand_params(params, s.mass_kg))
+    run = Model(stand.stand_params(params, s.mass_kg)).run(x, 2000.0)
     return pd.DataFrame(
         {"x_mm": x * 1e3, "u_mm": run.u_m * 1e3, "F_N": run.force_n},
         index=pd.Index(t, name="t_s"),

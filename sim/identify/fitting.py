@@ -24,17 +24,9 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import least_squares
 
-from recordings.diagnosis.shooting import segments_of, start_states
-from recordings.diagnosis.traces import Trace
 from sim.effects import EFFECTS, EffectSpec
-from sim.effects.measure import measure_batch_into, measurement_rows
-from sim.effects.simulator import (
-    augmented_row,
-    measure_segments,
-    simulate_augmented_rows,
-    simulate_augmented_segments,
-)
-from sim.model import param_vector, simulate_rows, simulate_segment_rows
+from sim.identify.traces import Trace
+from sim.model import Model, Variant
 from sim.params import StandParams
 
 FloatArray = NDArray[np.float64]
@@ -97,22 +89,22 @@ class Candidate:
         """Optimiser vector → named natural values."""
         return {p.name: p.to_natural(float(v)) for p, v in zip(self.params, z, strict=True)}
 
-    def stand_and_effects(
-        self, nominal: StandParams, values: dict[str, float], mass_kg: float
-    ) -> tuple[StandParams, list[EffectSpec]]:
-        """The stand and effect a set of values describes."""
-        stand = nominal.with_(
-            mass_kg=mass_kg,
-            stiffness_n_m=nominal.stiffness_n_m * values["stiffness_scale"],
-            damping_n_s_m=nominal.damping_n_s_m * values["damping_scale"],
-            friction_scale=nominal.friction_scale * values["friction_scale"],
-        )
-        effects = []
+    def model(self, nominal: StandParams, mass_kg: float) -> Model:
+        """The candidate's model: the nominal stand at this mass, with its effect."""
+        effects = [EffectSpec(self.effect)] if self.effect is not None else []
+        return Model(nominal.with_(mass_kg=mass_kg), effects)
+
+    def variant(self, nominal: StandParams, values: dict[str, float]) -> Variant:
+        """The model parameters a set of fitted values describes."""
+        changes = {
+            "stiffness_n_m": nominal.stiffness_n_m * values["stiffness_scale"],
+            "damping_n_s_m": nominal.damping_n_s_m * values["damping_scale"],
+            "friction_scale": nominal.friction_scale * values["friction_scale"],
+        }
         if self.effect is not None:
             prefix = f"{self.effect}."
-            own = {k[len(prefix) :]: v for k, v in values.items() if k.startswith(prefix)}
-            effects.append(EffectSpec(self.effect, own))
-        return stand, effects
+            changes.update({k: v for k, v in values.items() if k.startswith(prefix)})
+        return changes
 
     def start_points(self, baseline: dict[str, float] | None) -> list[FloatArray]:
         """Deterministic starts: from the baseline fit (or nominal), effect low/mid/default."""
@@ -141,64 +133,26 @@ class FitResult:
     evaluations: int
 
 
-#: Simulate by multiple shooting from measured states (``shooting``); False: open loop
-#: from rest over whole recordings (chaotic for the light weight in quick motions).
-SHOOTING = True
-
-
 def simulate_values(
-    candidate: Candidate, values: Sequence[dict[str, float]], trace: Trace, nominal: StandParams
+    candidate: Candidate,
+    values: Sequence[dict[str, float]],
+    trace: Trace,
+    nominal: StandParams,
+    shooting: bool = True,
 ) -> tuple[FloatArray, FloatArray]:
     """Recorded-channel outputs u (m), F (N) of a candidate for many value sets, in parallel.
 
-    The baseline and measurement effects run on the fast baseline kernel (a measurement
-    effect only transforms its outputs); physical effects on the augmented kernel (which
-    reproduces the baseline to 1e-9 with every effect off). With ``SHOOTING`` each trace
-    is simulated as segments restarted from measured states, assembled to full length.
+    With ``shooting`` (always, in the diagnosis) each trace is simulated as segments
+    restarted from measured states (``shooting``), assembled to full length; without, open
+    loop from rest over the whole trace (chaotic for the light weight in quick motions).
     """
-    x_rel = trace.x_m - trace.x_m[0]
-    stands = [candidate.stand_and_effects(nominal, v, trace.mass_kg) for v in values]
-    physical = candidate.effect is not None and EFFECTS[candidate.effect].kind == "physical"
-    if SHOOTING:
-        return _simulate_segments(candidate, stands, trace, x_rel, physical)
-    if not physical:
-        # Baseline dynamics on the fast kernel; a measurement effect only transforms them.
-        rows = np.stack([param_vector(stand) for stand, _ in stands])
-        base = simulate_rows(x_rel, trace.rate_hz, rows, nominal.friction)
-        if candidate.effect is None:
-            return base.u_m, base.force_n
-        mrows = measurement_rows(np.stack([augmented_row(s, e) for s, e in stands]))
-        out_u, out_f = np.empty_like(base.u_m), np.empty_like(base.force_n)
-        measure_batch_into(base.u_m, base.force_n, 1.0 / trace.rate_hz, mrows, out_u, out_f)
-        return out_u, out_f
-    rows = np.stack([augmented_row(stand, effects) for stand, effects in stands])
-    res = simulate_augmented_rows(x_rel, trace.rate_hz, rows, nominal.friction)
-    return res.u_m, res.force_n
-
-
-def _simulate_segments(
-    candidate: Candidate,
-    stands: Sequence[tuple[StandParams, list[EffectSpec]]],
-    trace: Trace,
-    x_rel: FloatArray,
-    physical: bool,
-) -> tuple[FloatArray, FloatArray]:
-    """``simulate_values`` by multiple shooting (see ``shooting``)."""
-    seg = segments_of(trace)
-    arows = np.stack([augmented_row(s, e) for s, e in stands])
-    init = start_states(seg, trace, arows)
-    table = stands[0][0].friction
-    if physical:
-        u, f = simulate_augmented_segments(
-            x_rel, trace.rate_hz, arows, table, seg.starts, seg.lengths, init
-        )
-    else:
-        rows = np.stack([param_vector(stand) for stand, _ in stands])
-        u, f = simulate_segment_rows(
-            x_rel, trace.rate_hz, rows, table, seg.starts, seg.lengths, init[:, :, :2]
-        )
-        if candidate.effect is not None:
-            u, f = measure_segments(u, f, trace.rate_hz, arows)
+    model = candidate.model(nominal, trace.mass_kg)
+    variants = [candidate.variant(nominal, v) for v in values]
+    if not shooting:
+        res = model.run_batch(trace.x_m, trace.rate_hz, variants)
+        return res.u_m, res.force_n
+    seg = trace.segments
+    u, f = model.run_segments(trace.x_m, trace.rate_hz, seg.restarts, variants)
     return seg.assemble(u), seg.assemble(f)
 
 

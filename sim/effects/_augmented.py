@@ -1,9 +1,8 @@
-"""The augmented simulator: the baseline model plus any combination of effects.
+"""The augmented simulator: the baseline plus effects (private: use ``sim.model.Model``).
 
-``simulate_augmented`` runs one stand with a list of effects, ``simulate_augmented_batch``
-many (stand, effects) sets in parallel, ``simulate_augmented_rows`` kernel rows directly
-(the fitting path: build rows once with ``augmented_row``, then vary the columns that
-``param_column`` names), and ``AugmentedStream`` advances block by block for the
+``simulate_augmented`` runs one stand with a list of effects, ``simulate_augmented_rows``
+kernel rows (built by ``augmented_row``), ``simulate_augmented_segments`` many short
+runs from measured states, and ``AugmentedStream`` advances block by block for the
 simulated stand. Physical effects change the dynamics (``sim.effects.kernel``);
 measurement effects then act on the outputs (``sim.effects.measure``).
 """
@@ -11,72 +10,26 @@ measurement effects then act on the outputs (``sim.effects.measure``).
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 
+from sim._baseline import DEFAULT_SUBSTEPS, check_input, friction_arrays, param_vector
 from sim.effects import kernel as ek
 from sim.effects import measure
-from sim.effects.registry import EFFECTS, EffectError, EffectSpec, check_unique, effect_info
-from sim.model import (
-    DEFAULT_SUBSTEPS,
-    BatchResult,
-    SimResult,
-    _check_input,
-    friction_arrays,
-    param_vector,
-)
+from sim.effects.registry import EffectError, EffectSpec, check_unique, effect_info
 from sim.params import FrictionTable, StandParams
+from sim.results import BatchResult, ModelRun
 
 FloatArray = NDArray[np.float64]
 
 __all__ = [
-    "AugmentedBatchResult",
-    "AugmentedResult",
     "AugmentedStream",
     "augmented_row",
-    "param_column",
     "simulate_augmented",
-    "simulate_augmented_batch",
     "simulate_augmented_rows",
     "simulate_augmented_segments",
 ]
-
-
-@dataclass(frozen=True)
-class AugmentedResult(SimResult):
-    """A SimResult (u_m and force_n as *recorded*) with the true channels beside it.
-
-    Attributes
-    ----------
-    true_u_m
-        Weight displacement before the dial gauge and skew, m.
-    true_force_n
-        Drive-side fibre tension before the force gauge and skew, N.
-    weight_force_n
-        Weight-side tension (differs from the drive side with the pulley's DOF), N.
-    max_substeps
-        Largest number of RK4 substeps one sample interval needed.
-    """
-
-    true_u_m: FloatArray
-    true_force_n: FloatArray
-    weight_force_n: FloatArray
-    max_substeps: int
-
-
-@dataclass(frozen=True)
-class AugmentedBatchResult(BatchResult):
-    """BatchResult (recorded u, F) plus the true channels, shape (sets, samples)."""
-
-    true_u_m: FloatArray
-    true_force_n: FloatArray
-
-
-def param_column(effect: str, param: str) -> int:
-    """Index of an effect parameter in a kernel row (to vary it across a batch)."""
-    return effect_info(effect).param(param).column
 
 
 def augmented_row(stand: StandParams, effects: Sequence[EffectSpec] = ()) -> FloatArray:
@@ -122,7 +75,7 @@ def simulate_augmented(
     stand: StandParams,
     effects: Sequence[EffectSpec] = (),
     substeps: int = DEFAULT_SUBSTEPS,
-) -> AugmentedResult:
+) -> ModelRun:
     """Simulate the stand with effects for a drive position series.
 
     Parameters
@@ -138,7 +91,7 @@ def simulate_augmented(
     substeps
         Least RK4 steps per sample interval (stiff effects take more as needed).
     """
-    x = _check_input(x_m, rate_hz)
+    x = check_input(x_m, rate_hz)
     n = x.shape[0]
     row = augmented_row(stand, effects)
     knots, coef = friction_arrays(stand.friction)
@@ -148,7 +101,7 @@ def simulate_augmented(
     t = np.arange(n) / rate_hz
     x_out = np.asarray(x_m, dtype=np.float64)
     t0 = stand.preload_tension_n
-    return AugmentedResult(t, x_out, rec_u, v, rec_f, t0, u, t1, t2, int(most))
+    return ModelRun(t, x_out, rec_u, v, rec_f, t0, u, t1, t2, int(most))
 
 
 def simulate_augmented_rows(
@@ -157,7 +110,7 @@ def simulate_augmented_rows(
     rows: FloatArray,
     table: FrictionTable | None,
     substeps: int = DEFAULT_SUBSTEPS,
-) -> AugmentedBatchResult:
+) -> BatchResult:
     """Lowest-level batch entry: kernel rows (``augmented_row``), drive relative to rest.
 
     ``x_rel_m`` is (N,) shared by all rows or (rows, N); all rows share one friction table.
@@ -174,31 +127,19 @@ def simulate_augmented_rows(
     ek.simulate_batch_into(x2, dt, substeps, rows2, knots, coef, u, v, t1, t2)
     rec_u, rec_f = np.empty_like(u), np.empty_like(t1)
     measure.measure_batch_into(u, t1, dt, measure.measurement_rows(rows2), rec_u, rec_f)
-    return AugmentedBatchResult(np.arange(n) / rate_hz, rec_u, v, rec_f, u, t1)
+    return BatchResult(np.arange(n) / rate_hz, rec_u, v, rec_f, u, t1)
 
 
-def simulate_augmented_batch(
-    x_m: FloatArray,
-    rate_hz: float,
-    sets: Sequence[tuple[StandParams, Sequence[EffectSpec]]],
-    substeps: int = DEFAULT_SUBSTEPS,
-) -> AugmentedBatchResult:
-    """Simulate many (stand, effects) sets on one drive series (or one per set), in parallel.
-
-    All stands must share one friction table (vary ``friction_scale`` instead).
-    """
-    x = np.asarray(x_m, dtype=np.float64)
-    rel = (
-        _check_input(x, rate_hz)
-        if x.ndim == 1
-        else np.stack([_check_input(row, rate_hz) for row in x])
-    )
-    tables = {stand.friction for stand, _ in sets if stand.friction is not None}
-    if len(tables) > 1:
-        raise EffectError("a batch must share one friction table (vary friction_scale)")
-    table = next(iter(tables)) if tables else None
-    rows = np.stack([augmented_row(stand, effects) for stand, effects in sets])
-    return simulate_augmented_rows(rel, rate_hz, rows, table, substeps)
+def measure_outputs(
+    u: FloatArray, force: FloatArray, rate_hz: float, rows: FloatArray
+) -> tuple[FloatArray, FloatArray]:
+    """Recorded u (m), F (N) of whole runs (sets, samples): the rows' gauge effects."""
+    out_u, out_f = np.empty_like(u), np.empty_like(force)
+    measure.measure_batch_into(
+        np.ascontiguousarray(u), np.ascontiguousarray(force), 1.0 / rate_hz,
+        measure.measurement_rows(rows), out_u, out_f,
+    )  # fmt: skip
+    return out_u, out_f
 
 
 def measure_segments(
@@ -227,6 +168,7 @@ def simulate_augmented_segments(
     lengths: NDArray[np.int64],
     init: FloatArray,
     substeps: int = DEFAULT_SUBSTEPS,
+    chained: bool = False,
 ) -> tuple[FloatArray, FloatArray]:
     """Multiple shooting: many short runs of many rows from measured states, in parallel.
 
@@ -234,20 +176,16 @@ def simulate_augmented_segments(
     v m/s, F N, high-passed elongation m; see ``ek.measured_state`` for how the effects'
     own states are set from it); a segment starting at sample 0 starts from static rest;
     string modes, bristles and the pulley seat carry over from the previous segment's
-    run. Returns the *recorded* u (m) and F (N), shape (sets, segments, max length), each
-    segment measured on its own (``measure_segments``), last value held past its end.
+    run when ``chained``. Returns the *recorded* u (m) and F (N), shape (sets, segments,
+    max length), each segment measured on its own (``measure_segments``), last value
+    held past its end.
     """
     rows2 = np.ascontiguousarray(np.atleast_2d(rows), dtype=np.float64)
     sets, segs, width = rows2.shape[0], starts.shape[0], int(lengths.max())
     u, t1 = np.empty((sets, segs, width)), np.empty((sets, segs, width))
     knots, coef = friction_arrays(table)
-    # String modes, bristles and the pulley seat carry over between segments (see
-    # simulate_chained_into).
-    chained = bool(
-        (rows2[:, ek.R_TV_ON] > 0).any()
-        or (rows2[:, ek.R_SS_ON] > 0).any()
-        or (rows2[:, ek.R_PJ_ON] > 0).any()
-    )
+    # ``chained``: string modes, bristles and the pulley seat carry over between
+    # segments (see simulate_chained_into); the model decides.
     kernel = ek.simulate_chained_into if chained else ek.simulate_segments_into
     kernel(
         np.ascontiguousarray(x_rel_m, dtype=np.float64), 1.0 / rate_hz, substeps, rows2,
@@ -343,8 +281,3 @@ class AugmentedStream:
             hist[:] = ext[ext.shape[0] - hist.shape[0] :]
             out.append(rec)
         return out[0], out[1]
-
-
-def known_effects() -> list[str]:
-    """Effect names in STAND.md order."""
-    return list(EFFECTS)

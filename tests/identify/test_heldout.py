@@ -7,16 +7,16 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from recordings.diagnosis.check import SMALL_CAMPAIGN, make_campaign
-from recordings.diagnosis.heldout import (
+from sim.config import StandConfig
+from sim.identify.check import SMALL_CAMPAIGN, make_campaign
+from sim.identify.heldout import (
     Outputs,
     bootstrap_confidence,
     cycle_improvements,
     heldout_error,
     heldout_excess,
 )
-from recordings.diagnosis.traces import Trace
-from sim.config import StandConfig
+from sim.identify.traces import Trace
 
 
 @pytest.fixture(scope="module")

@@ -3,19 +3,20 @@
 from __future__ import annotations
 
 import numpy as np
-import pandas as pd
 import pytest
 
 from drivers.signals import Shape, SignalSpec, plan_motion
-from recordings.diagnosis.fitting import Candidate, simulate_values
-from recordings.diagnosis.shooting import segment_trace, start_states
-from recordings.diagnosis.traces import Trace, make_trace
 from sim import kernel
+from sim._baseline import friction_arrays, param_vector, simulate_segment_rows
 from sim.config import StandConfig, default_config
-from sim.effects import EffectSpec, simulate_augmented
+from sim.effects import EffectSpec
 from sim.effects import kernel as ek
-from sim.effects.simulator import augmented_row, simulate_augmented_segments
-from sim.model import friction_arrays, param_vector, simulate, simulate_segment_rows
+from sim.effects._augmented import augmented_row, simulate_augmented_segments
+from sim.effects._starts import start_states
+from sim.identify.fitting import Candidate, simulate_values
+from sim.identify.shooting import segment_trace
+from sim.identify.traces import Trace, make_trace
+from sim.model import Model
 
 QUICK = SignalSpec(Shape.TRAPEZOIDAL, 0.025, 2.0, cycles=3, ramp_fraction=0.4)
 BASE = {"stiffness_scale": 1.0, "damping_scale": 1.0, "friction_scale": 1.0}
@@ -30,12 +31,9 @@ def _trace(
     stand: StandConfig, mass: float, effects: list[EffectSpec], noise_u: float = 0.0, seed: int = 0
 ) -> tuple[Trace, np.ndarray]:
     t, x = plan_motion(QUICK, stand.drive).sample(stand.sample_rate_hz)
-    run = simulate_augmented(x, stand.sample_rate_hz, stand.stand_params("final", mass), effects)
+    run = Model(stand.stand_params("final", mass), effects).run(x, stand.sample_rate_hz)
     u = run.u_m + np.random.default_rng(seed).normal(0.0, noise_u, x.size)
-    frame = pd.DataFrame(
-        {"x_mm": x * 1e3, "u_mm": u * 1e3, "F_N": run.force_n}, index=pd.Index(t, name="t_s")
-    )
-    return make_trace("quick", frame, mass), run.v_m_s
+    return make_trace("quick", t, x, u, run.force_n, mass), run.v_m_s
 
 
 def test_segments_tile_the_trace_and_start_calm(stand: StandConfig) -> None:
@@ -54,7 +52,7 @@ def test_segments_tile_the_trace_and_start_calm(stand: StandConfig) -> None:
 def test_a_segment_from_the_true_state_reproduces_the_open_loop_run(stand: StandConfig) -> None:
     params = stand.stand_params("final", 3.096)
     _, x = plan_motion(QUICK, stand.drive).sample(stand.sample_rate_hz)
-    run = simulate(x, stand.sample_rate_hz, params)
+    run = Model(params).run(x, stand.sample_rate_hz)
     rel = x - x[0]
     starts = np.array([0, 700, 1500], dtype=np.int64)
     lengths = np.array([700, 900, 600], dtype=np.int64)
@@ -121,8 +119,10 @@ def test_a_dial_gauge_candidate_starts_from_the_true_displacement(stand: StandCo
     values = dict(
         BASE, **{"dial_gauge_calibration.gain_error": 0.03, "dial_gauge_calibration.offset_m": 0.0}
     )
-    stand_p, effects = cand.stand_and_effects(stand.stand_params("final", 8.131), values, 8.131)
-    init = start_states(seg, tr, augmented_row(stand_p, effects)[None, :])
+    dial = EffectSpec("dial_gauge_calibration", {"gain_error": 0.03})
+    row = augmented_row(stand.stand_params("final", 8.131), [dial])[None, :]
+    x_rel = tr.x_m - tr.x_m[0]
+    init = start_states(row, x_rel, tr.rate_hz, seg.starts, seg.u_m, seg.v_m_s, seg.force_n)
     np.testing.assert_allclose(init[0, :, ek.I_U], seg.u_m[seg.starts] / 1.03)
     # And the candidate then predicts the recording to noise level, the baseline does not.
     nominal = stand.stand_params("final", 8.131)
@@ -146,13 +146,9 @@ def test_restarts_only_after_slack(stand: StandConfig) -> None:
     # Taut all through (heavy weight, slow quasi-sine): one open-loop run, no restarts.
     slow = SignalSpec(Shape.QUASI_SINUSOIDAL, 0.060, 0.5, cycles=2)
     t, x = plan_motion(slow, stand.drive).sample(stand.sample_rate_hz)
-    run = simulate(x, stand.sample_rate_hz, stand.stand_params("final", 8.131))
+    run = Model(stand.stand_params("final", 8.131)).run(x, stand.sample_rate_hz)
     assert run.force_n.min() > 0.5 * run.preload_tension_n
-    frame = pd.DataFrame(
-        {"x_mm": x * 1e3, "u_mm": run.u_m * 1e3, "F_N": run.force_n},
-        index=pd.Index(t, name="t_s"),
-    )
-    assert segment_trace(make_trace("slow", frame, 8.131)).count == 1
+    assert segment_trace(make_trace("slow", t, x, run.u_m, run.force_n, 8.131)).count == 1
     # Slack every cycle (light weight, quick): a boundary follows every slack episode.
     tr, _ = _trace(stand, 3.096, [])
     seg = segment_trace(tr)
@@ -188,13 +184,12 @@ def test_chained_segments_equal_independent_ones_without_carried_states(
 
 
 def test_string_modes_carry_over_so_a_ringing_fibre_restarts_right(
-    stand: StandConfig, monkeypatch: pytest.MonkeyPatch
+    stand: StandConfig,
 ) -> None:
     # A clean recording of the true model with ringing spans (light weight, slack every
     # cycle): restarting the spans at static sag cost 5.6x the open-loop error; carried
     # over from the previous segment they predict as well as one open-loop run.
-    from recordings.diagnosis import fitting
-    from recordings.diagnosis.heldout import Outputs, heldout_error
+    from sim.identify.heldout import Outputs, heldout_error
 
     effect = "fibre_transverse_vibration"
     spec = EffectSpec(effect, {"damping_ratio": 0.012, "load_scale": 0.6})
@@ -204,22 +199,20 @@ def test_string_modes_carry_over_so_a_ringing_fibre_restarts_right(
     nominal = stand.stand_params("final", 3.096)
     errors = []
     for shooting in (True, False):
-        monkeypatch.setattr(fitting, "SHOOTING", shooting)
-        u, f = simulate_values(cand, [values], tr, nominal)
+        u, f = simulate_values(cand, [values], tr, nominal, shooting=shooting)
         errors.append(heldout_error([tr], [Outputs(u[0], f[0])]))
     assert segment_trace(tr).count > 3
     assert errors[0] < 1.2 * errors[1]
 
 
 def test_the_pulley_seat_carries_over_so_restarts_keep_the_right_groove(
-    stand: StandConfig, monkeypatch: pytest.MonkeyPatch
+    stand: StandConfig,
 ) -> None:
     # The seat toggles between two grooves on every deep slack episode; a restart cannot
     # see which (a tenth of a millimetre in a noisy elongation). Carried over from the
     # previous segment's run, the true model predicts a clean recording as well as one
     # open-loop run (a seat estimated at each restart cost 340x).
-    from recordings.diagnosis import fitting
-    from recordings.diagnosis.heldout import Outputs, heldout_error
+    from sim.identify.heldout import Outputs, heldout_error
 
     effect = "fibre_pulley_jump"
     params = {"step_m": 1.3e-4, "depth_scale_m": 3.1e-3}
@@ -228,8 +221,7 @@ def test_the_pulley_seat_carries_over_so_restarts_keep_the_right_groove(
     nominal = stand.stand_params("final", 3.096)
     errors = []
     for shooting in (True, False):
-        monkeypatch.setattr(fitting, "SHOOTING", shooting)
-        u, f = simulate_values(Candidate.build(effect), [values], tr, nominal)
+        u, f = simulate_values(Candidate.build(effect), [values], tr, nominal, shooting=shooting)
         errors.append(heldout_error([tr], [Outputs(u[0], f[0])]))
     assert segment_trace(tr).count > 3
     assert errors[0] < 1.2 * errors[1]

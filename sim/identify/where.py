@@ -8,12 +8,12 @@ traces; shares within one breakdown add up to 1.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 
-from recordings.diagnosis.traces import PHASES, Trace
+from sim.identify.traces import PHASES, Trace
 
 FloatArray = NDArray[np.float64]
 
@@ -60,7 +60,25 @@ def _shares(energy: dict[str, float]) -> dict[str, float]:
     return {k: (v / total if total > 0 else 0.0) for k, v in energy.items()}
 
 
-def where_the_gap_lies(traces: Sequence[Trace], states: Sequence[SimStates]) -> dict[str, object]:
+@dataclass(frozen=True)
+class Where:
+    """Shares of the fitted baseline's normalised squared residual (each breakdown sums to 1).
+
+    ``phase``, ``regime`` and ``band`` are per channel (``u``, ``F``).
+    """
+
+    channel: dict[str, float]
+    phase: dict[str, dict[str, float]]
+    regime: dict[str, dict[str, float]]
+    band: dict[str, dict[str, float]]
+    time_in_regime_s: dict[str, float]
+
+    def to_dict(self) -> dict[str, object]:
+        """JSON keys channel, phase, regime, band, time_in_regime_s."""
+        return asdict(self)
+
+
+def where_the_gap_lies(traces: Sequence[Trace], states: Sequence[SimStates]) -> Where:
     """The breakdowns for the residual of the fitted baseline (see module docstring)."""
     by_channel = dict.fromkeys(CHANNELS, 0.0)
     by_phase = {c: dict.fromkeys(PHASES, 0.0) for c in CHANNELS}
@@ -83,13 +101,13 @@ def where_the_gap_lies(traces: Sequence[Trace], states: Sequence[SimStates]) -> 
                 by_regime[channel][name] += float(e[reg == k].sum())
             for name, value in zip(_band_names(), _band_energy(r, tr.rate_hz), strict=True):
                 by_band[channel][name] += float(value)
-    return {
-        "channel": _shares(by_channel),
-        "phase": {c: _shares(v) for c, v in by_phase.items()},
-        "regime": {c: _shares(v) for c, v in by_regime.items()},
-        "band": {c: _shares(v) for c, v in by_band.items()},
-        "time_in_regime_s": time_in_regime,
-    }
+    return Where(
+        channel=_shares(by_channel),
+        phase={c: _shares(v) for c, v in by_phase.items()},
+        regime={c: _shares(v) for c, v in by_regime.items()},
+        band={c: _shares(v) for c, v in by_band.items()},
+        time_in_regime_s=time_in_regime,
+    )
 
 
 def _band_names() -> list[str]:

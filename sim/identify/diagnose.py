@@ -21,19 +21,20 @@ import logging
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import Any, TypedDict
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from recordings.diagnosis.fitting import (
+from sim.effects import EFFECTS
+from sim.identify.fitting import (
     Candidate,
     FitResult,
     effect_grid_start,
     fit,
     simulate_values,
 )
-from recordings.diagnosis.heldout import (
+from sim.identify.heldout import (
     Outputs,
     bootstrap_confidence,
     channel_gap,
@@ -42,9 +43,8 @@ from recordings.diagnosis.heldout import (
     heldout_excess,
     noise_floor,
 )
-from recordings.diagnosis.traces import Trace
-from recordings.diagnosis.where import SimStates, where_the_gap_lies
-from sim.effects import EFFECTS
+from sim.identify.traces import Trace
+from sim.identify.where import SimStates, Where, where_the_gap_lies
 from sim.params import StandParams
 
 FloatArray = NDArray[np.float64]
@@ -76,36 +76,54 @@ PARAM_PENALTY = 0.003
 Progress = Callable[[str], None]
 
 
-class RankedEffect(TypedDict):
-    """One candidate's line in the ranking (JSON as is)."""
+@dataclass
+class RankedEffect:
+    """One candidate's line in the ranking."""
 
     effect: str
-    #: Held-out gap closure after the penalty; None when the candidate was not refitted.
-    score: float | None
-    #: Held-out RMS of the channels' NRMSE.
-    heldout_error: float | None
-    #: Held-out error in noise units (what the score is made of; 1 = perfect).
-    heldout_excess: float | None
     #: Share of the baseline residual the screening probe explained.
     screening: float
-    params: dict[str, float]
+    #: Held-out gap closure after the penalty; None when the candidate was not refitted.
+    score: float | None = None
+    #: Held-out RMS of the channels' NRMSE.
+    heldout_error: float | None = None
+    #: Held-out error in noise units (what the score is made of; 1 = perfect).
+    heldout_excess: float | None = None
+    params: dict[str, float] = field(default_factory=dict)
+
+    def to_dict(self) -> dict[str, object]:
+        """JSON keys effect, score, heldout_error, heldout_excess, screening, params."""
+        return {
+            "effect": self.effect,
+            "score": self.score,
+            "heldout_error": self.heldout_error,
+            "heldout_excess": self.heldout_excess,
+            "screening": self.screening,
+            "params": self.params,
+        }
+
+
+#: Per channel (``u``, ``F``): R, psi and NRMSE on the held-out samples.
+ChannelGap = dict[str, dict[str, float]]
 
 
 @dataclass
 class Diagnosis:
-    """The answer (see to_dict for the JSON)."""
+    """The answer: the typed report the CLI and the HTML page both read (``to_dict``: JSON)."""
 
     effect: str
     ranking: list[RankedEffect]
-    where: dict[str, Any]
-    gap_before: dict[str, dict[str, float]]
-    gap_after: dict[str, dict[str, float]]
+    where: Where
+    gap_before: ChannelGap
+    gap_after: ChannelGap
     baseline: dict[str, float]
     heldout_error_before: float
     heldout_error_after: float
     noise_floor: float
     gap_closure: float
     confidence: float
+    #: The least held-out gap closure an effect needed to be the answer.
+    closure_needed: float = MIN_GAP_CLOSURE
     timings_s: dict[str, float] = field(default_factory=dict)
     simulations: int = 0
     outputs_before: list[Outputs] = field(default_factory=list, repr=False)
@@ -115,8 +133,8 @@ class Diagnosis:
         """JSON keys: effect, ranking, where, gap_before, gap_after, and details."""
         return {
             "effect": self.effect,
-            "ranking": self.ranking,
-            "where": self.where,
+            "ranking": [r.to_dict() for r in self.ranking],
+            "where": self.where.to_dict(),
             "gap_before": self.gap_before,
             "gap_after": self.gap_after,
             "baseline_fit": self.baseline,
@@ -124,6 +142,7 @@ class Diagnosis:
             "heldout_error_after": self.heldout_error_after,
             "noise_floor": self.noise_floor,
             "gap_closure": self.gap_closure,
+            "closure_needed": self.closure_needed,
             "confidence": self.confidence,
             "simulations": self.simulations,
             "timings_s": self.timings_s,
@@ -293,57 +312,41 @@ def diagnose(
 
     ranking: list[RankedEffect] = []
     for effect in order:
+        line = RankedEffect(effect, screening=scores[effect])
         if effect in refits:
             res, outs, x_aug = refits[effect]
             penalised = x_aug * (1 + PARAM_PENALTY * (len(res.candidate.params) - 3))
             # Gap closure; clipped below at −1 (far worse than the baseline is just worse).
-            closure = max(-1.0, (x_base - penalised) / max(x_base - 1.0, 1e-12))
-            ranking.append(
-                {
-                    "effect": effect,
-                    "score": closure,
-                    "heldout_error": heldout_error(traces, outs),
-                    "heldout_excess": x_aug,
-                    "screening": scores[effect],
-                    "params": _effect_params(effect, res.values),
-                }
-            )
-        else:
-            ranking.append(
-                {
-                    "effect": effect,
-                    "score": None,
-                    "heldout_error": None,
-                    "heldout_excess": None,
-                    "screening": scores[effect],
-                    "params": {},
-                }
-            )
-    ranking.sort(key=lambda r: (r["score"] is None, -(r["score"] or 0.0), -r["screening"]))
+            line.score = max(-1.0, (x_base - penalised) / max(x_base - 1.0, 1e-12))
+            line.heldout_error = heldout_error(traces, outs)
+            line.heldout_excess = x_aug
+            line.params = _effect_params(effect, res.values)
+        ranking.append(line)
+    ranking.sort(key=lambda r: (r.score is None, -(r.score or 0.0), -r.screening))
 
     chosen = "none"
     confidence = 0.0
     after_out = base_out
     best = ranking[0]
-    if best["score"] is not None:
-        _, outs, x_aug = refits[best["effect"]]
+    if best.score is not None:
+        _, outs, x_aug = refits[best.effect]
         gains = cycle_improvements(traces, base_out, outs)
         confidence = bootstrap_confidence(gains)
         relative = (x_base - x_aug) / x_base if x_base > 0 else 0.0
         log.info(
             "best %s: closure %.3f, relative %.3f, confidence %.3f",
-            best["effect"],
-            best["score"],
+            best.effect,
+            best.score,
             relative,
             confidence,
         )
         if (
-            best["score"] >= MIN_GAP_CLOSURE
+            best.score >= MIN_GAP_CLOSURE
             and relative >= MIN_RELATIVE_GAIN
             and x_base - x_aug >= MIN_GAIN_OVER_NOISE
             and confidence >= MIN_CONFIDENCE
         ):
-            chosen = best["effect"]
+            chosen = best.effect
             say(f"polishing {chosen}")
             started = time.perf_counter()
             res = refits[chosen][0]
@@ -360,7 +363,7 @@ def diagnose(
             # Judged on the training cycles only; the held-out ones then say how far.
             if polished.train_cost < res.train_cost:
                 outs = _outputs(polished.candidate, polished.values, traces, nominal)
-                best["params"] = _effect_params(chosen, polished.values)
+                best.params = _effect_params(chosen, polished.values)
             after_out = outs
     x_after = heldout_excess(traces, after_out)
     timings["total"] = time.perf_counter() - t0

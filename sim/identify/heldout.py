@@ -8,8 +8,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from recordings.diagnosis.traces import Trace
-from recordings.metrics import channel_metrics
+from sim.identify.traces import Trace
+from sim.metrics import channel_metrics
 
 FloatArray = NDArray[np.float64]
 

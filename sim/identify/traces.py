@@ -9,13 +9,14 @@ which cycle each sample belongs to, and whether it is used for fitting or held o
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
-import pandas as pd
 from numpy.typing import NDArray
 from scipy.signal import butter, sosfiltfilt
 
-from recordings.replay import ReplayError, align
+from sim.grid import GridError, align_arrays
+from sim.identify.shooting import Segments, segment_trace
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -73,6 +74,11 @@ class Trace:
     def duration_s(self) -> float:
         """Length of the grid, s."""
         return self.samples / self.rate_hz
+
+    @cached_property
+    def segments(self) -> Segments:
+        """How multiple shooting cuts this trace (computed once per trace)."""
+        return segment_trace(self)
 
 
 def drive_phases(x_m: FloatArray, rate_hz: float) -> IntArray:
@@ -141,11 +147,21 @@ def _smooth_drive(x_m: FloatArray, rate_hz: float) -> FloatArray:
     return smoothed
 
 
-def make_trace(name: str, frame: pd.DataFrame, mass_kg: float) -> Trace:
-    """Prepare one recording (its DataFrame: t_s index, x_mm, u_mm, F_N)."""
+def make_trace(
+    name: str,
+    t_s: FloatArray,
+    x_m: FloatArray,
+    u_m: FloatArray,
+    force_n: FloatArray,
+    mass_kg: float,
+) -> Trace:
+    """Prepare one recording from its measured series (s, m, m, N; NaN where lost).
+
+    ``name`` only labels messages and reports (the file name, for a recording).
+    """
     try:
-        run = align(frame)
-    except ReplayError as err:
+        run = align_arrays(t_s, x_m, u_m, force_n)
+    except GridError as err:
         raise DiagnosisInputError(f"{name}: {err}") from None
     if run.t_s[-1] < MIN_DURATION_S:
         raise DiagnosisInputError(

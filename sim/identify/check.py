@@ -19,15 +19,15 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-import pandas as pd
 
 from drivers.signals import Shape, SignalSpec, plan_motion
-from recordings.diagnosis.diagnose import diagnose
-from recordings.diagnosis.heldout import Outputs, heldout_error
-from recordings.diagnosis.traces import Trace, make_trace
 from sim.config import StandConfig
-from sim.effects import EFFECTS, EffectSpec, simulate_augmented
+from sim.effects import EFFECTS, EffectSpec
 from sim.effects.realism import MeasurementNoise, NoiseSpec, draw_real_stand
+from sim.identify.diagnose import diagnose
+from sim.identify.heldout import Outputs, heldout_error
+from sim.identify.traces import Trace, make_trace
+from sim.model import Model
 
 log = logging.getLogger(__name__)
 
@@ -123,15 +123,11 @@ def make_campaign(
     traces, oracle = [], []
     for name, signal in campaign:
         t, x = plan_motion(signal, stand.drive).sample(stand.sample_rate_hz)
-        run = simulate_augmented(x, stand.sample_rate_hz, real, effects)
+        run = Model(real, effects).run(x, stand.sample_rate_hz)
         gauges = MeasurementNoise(noise, stand.sample_rate_hz, rng)
         u_rec, f_rec = gauges.apply(run.u_m, run.force_n)
         x_rec = np.round((x + rng.normal(0.0, DRIVE_NOISE_M, x.size)) / 1e-7) * 1e-7
-        frame = pd.DataFrame(
-            {"x_mm": x_rec * 1e3, "u_mm": u_rec * 1e3, "F_N": f_rec},
-            index=pd.Index(t, name="t_s"),
-        )
-        trace = make_trace(name, frame, mass_kg)
+        trace = make_trace(name, t, x_rec, u_rec, f_rec, mass_kg)
         traces.append(trace)
         # The trace's u counts from its rest value; the model's rest is u = 0 (plus any
         # dial gauge offset, which the rest value removes).

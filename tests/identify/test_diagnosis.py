@@ -10,10 +10,11 @@ import pandas as pd
 import pytest
 
 from labstand.cli import main
-from recordings.diagnosis import DiagnosisInputError, diagnose, make_trace
-from recordings.diagnosis.check import SMALL_CAMPAIGN, make_campaign, run_check
-from recordings.diagnosis.traces import PHASE_FALL, PHASE_HOLD, PHASE_REST, PHASE_RISE
+from labstand.commands.diagnose import trace_of
 from sim.config import StandConfig
+from sim.identify import DiagnosisInputError, diagnose
+from sim.identify.check import SMALL_CAMPAIGN, make_campaign, run_check
+from sim.identify.traces import PHASE_FALL, PHASE_HOLD, PHASE_REST, PHASE_RISE
 
 
 def _frame(t: np.ndarray, x: np.ndarray) -> pd.DataFrame:
@@ -47,7 +48,7 @@ def test_phases_and_cycles_follow_the_drive(stand: StandConfig) -> None:
 def test_undiagnosable_input_says_what_is_missing(make, message: str) -> None:  # type: ignore[no-untyped-def]
     t = np.arange(8000) / 2000.0
     with pytest.raises(DiagnosisInputError, match=message):
-        make_trace("rec.csv", make(t), 8.131)
+        trace_of("rec.csv", make(t), 8.131)
 
 
 def test_a_dial_gauge_gain_error_is_found_and_the_gap_shrinks(stand: StandConfig) -> None:
@@ -55,20 +56,20 @@ def test_a_dial_gauge_gain_error_is_found_and_the_gap_shrinks(stand: StandConfig
     traces, _, params = make_campaign(stand, "dial_gauge_calibration", 8.131, rng, SMALL_CAMPAIGN)
     result = diagnose(traces, stand.stand_params("final", 8.131))
     assert result.effect == "dial_gauge_calibration"
-    assert result.ranking[0]["effect"] == "dial_gauge_calibration"
-    fitted = result.ranking[0]["params"]["gain_error"]
+    assert result.ranking[0].effect == "dial_gauge_calibration"
+    fitted = result.ranking[0].params["gain_error"]
     assert fitted == pytest.approx(params["gain_error"], abs=0.1 * abs(params["gain_error"]) + 1e-3)
     assert result.gap_after["u"]["nrmse"] < 0.8 * result.gap_before["u"]["nrmse"]
     # Segments start from the measured u, so a gain error also shows in F (the start
     # elongation is off); explaining it must not make F worse.
     assert result.gap_after["F"]["nrmse"] <= result.gap_before["F"]["nrmse"] * 1.05
-    assert sum(result.where["channel"].values()) == pytest.approx(1.0)
+    assert sum(result.where.channel.values()) == pytest.approx(1.0)
 
 
 def test_where_attributes_a_residual_to_its_channel_phase_regime_and_band(
     stand: StandConfig,
 ) -> None:
-    from recordings.diagnosis.where import SimStates, where_the_gap_lies
+    from sim.identify.where import SimStates, where_the_gap_lies
 
     traces, _, _ = make_campaign(stand, "none", 8.131, np.random.default_rng(1), SMALL_CAMPAIGN)
     tr = traces[0]
@@ -79,10 +80,10 @@ def test_where_attributes_a_residual_to_its_channel_phase_regime_and_band(
     error = np.where(tr.phase == PHASE_FALL, 0.5 * np.sin(2 * np.pi * 50 * t), 0.0)
     states = SimStates(u, f + error, np.zeros_like(u) + 0.1)
     where = where_the_gap_lies([tr], [states])
-    assert where["channel"]["F"] == pytest.approx(1.0)
-    assert where["phase"]["F"]["fall"] == pytest.approx(1.0)
-    assert where["band"]["F"]["20-100 Hz"] > 0.7
-    assert where["regime"]["F"]["taut"] + where["regime"]["F"]["snatch"] > 0.99
+    assert where.channel["F"] == pytest.approx(1.0)
+    assert where.phase["F"]["fall"] == pytest.approx(1.0)
+    assert where.band["F"]["20-100 Hz"] > 0.7
+    assert where.regime["F"]["taut"] + where.regime["F"]["snatch"] > 0.99
 
 
 def test_stand_mismatch_alone_is_fitted_away_and_answered_none(stand: StandConfig) -> None:

@@ -6,7 +6,7 @@ Exceptions::
      └── DiagnosisInputError   recordings that cannot be diagnosed (says what is missing)
 """
 
-from recordings.diagnosis.diagnose import Diagnosis, diagnose
-from recordings.diagnosis.traces import DiagnosisInputError, Trace, make_trace
+from sim.identify.diagnose import Diagnosis, diagnose
+from sim.identify.traces import DiagnosisInputError, Trace, make_trace
 
 __all__ = ["Diagnosis", "DiagnosisInputError", "Trace", "diagnose", "make_trace"]

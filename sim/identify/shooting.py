@@ -24,11 +24,11 @@ at most one segment and the fit compares the model's short-term dynamics with th
 * The start state: u and v from a local cubic least-squares (Savitzky–Golay) fit of the
   recorded u over ±``STATE_HALF_WIDTH_S``; F likewise smoothed. A candidate's measurement
   effect is inverted first (the dial gauge's gain and offset, the displacement channel's
-  skew), so the state is the true one the candidate implies. The effects' own states are
-  set by ``sim.effects.kernel.measured_state``: quasi-static values, and for the Maxwell
-  branch its response to the measured elongation history. Those the gauges cannot see at
-  a start (string modes, LuGre bristle, pulley seat) carry over from the previous
-  segment's run instead (``simulate_chained_into``).
+  skew), so the state is the true one the candidate implies. The model does that
+  (``sim.model.Model.run_segments``), and sets the effects' own states: quasi-static
+  values, and for the Maxwell branch its response to the measured elongation history.
+  Those the gauges cannot see at a start (string modes, LuGre bristle, pulley seat) carry
+  over from the previous segment's run instead.
 * The first segment starts at sample 0 from static rest, exactly as an open-loop run.
 
 Held-out cycles are then judged on segment predictions as well; that is fair because
@@ -37,15 +37,17 @@ every start state comes from measurements, never from a fitted trajectory.
 
 from __future__ import annotations
 
-import weakref
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.signal import lfilter, savgol_filter
+from scipy.signal import savgol_filter
 
-from recordings.diagnosis.traces import Trace
-from sim.effects import kernel as ek
+from sim.model import Restarts
+
+if TYPE_CHECKING:  # the trace holds its segments; only its type is needed here
+    from sim.identify.traces import Trace
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -91,6 +93,11 @@ class Segments:
     def count(self) -> int:
         """Number of segments."""
         return int(self.starts.size)
+
+    @property
+    def restarts(self) -> Restarts:
+        """The segment starts and measured channels, as the model takes them."""
+        return Restarts(self.starts, self.lengths, self.u_m, self.v_m_s, self.force_n)
 
     def assemble(self, runs: FloatArray) -> FloatArray:
         """Segment runs (sets, segments, samples) → one series per set (sets, N)."""
@@ -153,62 +160,3 @@ def segment_trace(
     seg_of = np.repeat(np.arange(body.size), ends - body).astype(np.int64)
     offset = (np.arange(trace.samples) - starts[seg_of]).astype(np.int64)
     return Segments(starts, lengths, body, u_s, v_s, f_s, seg_of, offset)
-
-
-_CACHE: dict[int, tuple[weakref.ref[Trace], Segments]] = {}
-
-
-def segments_of(trace: Trace) -> Segments:
-    """``segment_trace`` with the default settings, memoised per trace object."""
-    hit = _CACHE.get(id(trace))
-    if hit is not None and hit[0]() is trace:
-        return hit[1]
-    seg = segment_trace(trace)
-    for key in [k for k, (ref, _) in _CACHE.items() if ref() is None]:
-        del _CACHE[key]
-    _CACHE[id(trace)] = (weakref.ref(trace), seg)
-    return seg
-
-
-def start_states(seg: Segments, trace: Trace, rows: FloatArray) -> FloatArray:
-    """Measured start states (sets, segments, ek.N_INIT) for augmented kernel rows.
-
-    A row's measurement effects are inverted: the dial gauge reads (1 + g)·u + offset,
-    so u = (u_rec − offset)/(1 + g); a displacement channel recorded Δt late shows the
-    true u of Δt earlier, so the true u now is u_rec(t + Δt) ≈ u_rec + Δt·v.
-    """
-    rows2 = np.atleast_2d(rows)
-    idx = seg.starts
-    u = np.broadcast_to(seg.u_m[idx], (rows2.shape[0], idx.size)).copy()
-    v = np.broadcast_to(seg.v_m_s[idx], u.shape).copy()
-    skew = np.where(rows2[:, ek.R_CS_ON] > 0, rows2[:, ek.R_CS_DISP], 0.0)[:, None]
-    u = u + skew * v
-    dial = rows2[:, ek.R_DG_ON] > 0
-    gain = np.where(dial, 1.0 + rows2[:, ek.R_DG_GAIN], 1.0)[:, None]
-    offset = np.where(dial, rows2[:, ek.R_DG_OFFSET], 0.0)[:, None]
-    u = (u - offset) / gain
-    v = v / gain
-    init = np.zeros((rows2.shape[0], idx.size, ek.N_INIT))
-    init[:, :, ek.I_U] = u
-    init[:, :, ek.I_V] = v
-    init[:, :, ek.I_F] = seg.force_n[idx]
-    for b, row in enumerate(rows2):
-        if row[ek.R_VE_ON] > 0:
-            init[b, :, ek.I_HP] = _branch_elongation(seg, trace, row)[idx]
-    return init
-
-
-def _branch_elongation(seg: Segments, trace: Trace, row: FloatArray) -> FloatArray:
-    """The Maxwell branch's elongation q/k₂ along the trace, from the measured history.
-
-    q̇ = k₂·δ̇ − q/τ while taut and q̇ = −q/τ while slack: q/k₂ is the elongation
-    max(δ, 0) high-passed with time constant τ (first order, discretised exactly for a
-    step input).
-    """
-    x = trace.x_m - trace.x_m[0]
-    delta = np.maximum(row[ek.P_PRELOAD] + x - row[ek.P_PROJ] * seg.u_m, 0.0)
-    a = float(np.exp(-1.0 / (trace.rate_hz * row[ek.R_VE_TAU])))
-    # y_k = a·y_{k−1} + (δ_k − δ_{k−1}), from rest (y = 0 at the start).
-    d = np.diff(delta, prepend=delta[0])
-    out: FloatArray = lfilter([1.0], [1.0, -a], d)
-    return out

@@ -1,0 +1,73 @@
+"""Segment start states from measurements, per kernel row (private: ``sim.model`` uses it).
+
+A segment of a multiple-shooting run restarts from the state the gauges measured. What
+a gauge reads is not the true state when a candidate says the gauge errs, so a row's
+measurement effects are inverted first: the dial gauge reads (1 + g)·u + offset, so
+u = (u_rec − offset)/(1 + g); a displacement channel recorded Δt late shows the true u
+of Δt earlier, so the true u now is u_rec(t + Δt) ≈ u_rec + Δt·v. The Maxwell branch's
+state is its response to the measured elongation history. The other effects' states are
+set inside the kernel (``kernel.measured_state``) or carried between segments.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.signal import lfilter
+
+from sim.effects import kernel as ek
+
+FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.int64]
+
+__all__ = ["start_states"]
+
+
+def start_states(
+    rows: FloatArray,
+    x_rel_m: FloatArray,
+    rate_hz: float,
+    starts: IntArray,
+    u_m: FloatArray,
+    v_m_s: FloatArray,
+    force_n: FloatArray,
+) -> FloatArray:
+    """Measured start states (sets, segments, ek.N_INIT) for augmented kernel rows.
+
+    ``u_m``, ``v_m_s``, ``force_n``: the recorded channels (smoothed) at every sample.
+    """
+    rows2 = np.atleast_2d(rows)
+    u = np.broadcast_to(u_m[starts], (rows2.shape[0], starts.size)).copy()
+    v = np.broadcast_to(v_m_s[starts], u.shape).copy()
+    skew = np.where(rows2[:, ek.R_CS_ON] > 0, rows2[:, ek.R_CS_DISP], 0.0)[:, None]
+    u = u + skew * v
+    dial = rows2[:, ek.R_DG_ON] > 0
+    gain = np.where(dial, 1.0 + rows2[:, ek.R_DG_GAIN], 1.0)[:, None]
+    offset = np.where(dial, rows2[:, ek.R_DG_OFFSET], 0.0)[:, None]
+    u = (u - offset) / gain
+    v = v / gain
+    init = np.zeros((rows2.shape[0], starts.size, ek.N_INIT))
+    init[:, :, ek.I_U] = u
+    init[:, :, ek.I_V] = v
+    init[:, :, ek.I_F] = force_n[starts]
+    for b, row in enumerate(rows2):
+        if row[ek.R_VE_ON] > 0:
+            init[b, :, ek.I_HP] = _branch_elongation(row, x_rel_m, rate_hz, u_m)[starts]
+    return init
+
+
+def _branch_elongation(
+    row: FloatArray, x_rel_m: FloatArray, rate_hz: float, u_m: FloatArray
+) -> FloatArray:
+    """The Maxwell branch's elongation q/k₂ along the trace, from the measured history.
+
+    q̇ = k₂·δ̇ − q/τ while taut and q̇ = −q/τ while slack: q/k₂ is the elongation
+    max(δ, 0) high-passed with time constant τ (first order, discretised exactly for a
+    step input).
+    """
+    delta = np.maximum(row[ek.P_PRELOAD] + x_rel_m - row[ek.P_PROJ] * u_m, 0.0)
+    a = float(np.exp(-1.0 / (rate_hz * row[ek.R_VE_TAU])))
+    # y_k = a·y_{k−1} + (δ_k − δ_{k−1}), from rest (y = 0 at the start).
+    d = np.diff(delta, prepend=delta[0])
+    out: FloatArray = lfilter([1.0], [1.0, -a], d)
+    return out
