@@ -123,7 +123,9 @@ def write_report(directory: Path, traces: Sequence[Trace], result: Diagnosis) ->
     where = result.where
     ranking_rows = "".join(
         f"<tr><td>{html.escape(r.effect)}</td><td>{_fmt(r.score)}</td>"
-        f"<td>{_fmt(r.screening)}</td><td>{_fmt(r.params)}</td></tr>"
+        f"<td>{_fmt(r.screening)}</td><td>{_fmt(r.params)}"
+        f"{' — at its bound: ' + html.escape(', '.join(r.at_bound)) if r.at_bound else ''}"
+        "</td></tr>"
         for r in result.ranking
     )
     page = f"""<!doctype html>

@@ -115,7 +115,8 @@ def _print_summary(result: Diagnosis, report: Path | None) -> None:
     print("Ranking (score = held-out gap closure; screening = share of residual explained):")
     for r in result.ranking[:5]:
         score = "   —  " if r.score is None else f"{r.score:6.3f}"
-        print(f"  {r.effect:28s} score {score}  screening {r.screening:.3f}")
+        bound = f"  ({', '.join(r.at_bound)} at its bound)" if r.at_bound else ""
+        print(f"  {r.effect:28s} score {score}  screening {r.screening:.3f}{bound}")
     print("Where (share of the baseline's residual):")
     print("  channel: " + ", ".join(f"{k} {v:.0%}" for k, v in result.where.channel.items()))
     if report is not None:

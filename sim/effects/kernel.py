@@ -378,7 +378,11 @@ def _after_part(c, y, x, xd):  # type: ignore[no-untyped-def]
                 c[S_DEPTH] = slack
                 base, step = c[S_LBASE], c[R_PJ_STEP]
                 target = step if abs(base) <= abs(base - step) else 0.0  # the other seat
-                c[S_LOFF] = base + (target - base) * (1.0 - math.exp(-slack / c[R_PJ_DEPTH]))
+                change = (target - base) * (1.0 - math.exp(-slack / c[R_PJ_DEPTH]))
+                # The seat moves no further than the slack lets it (exact no-op while
+                # |step| ≤ depth scale, since 1 − e^(−a) ≤ a).
+                change = max(-slack, min(slack, change))
+                c[S_LOFF] = base + change
         elif c[S_DEPTH] > 0.0:  # the episode is over: the fibre stays in its new seat
             c[S_LBASE] = c[S_LOFF]
             c[S_DEPTH] = 0.0

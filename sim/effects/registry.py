@@ -1,9 +1,12 @@
 """The nine effects of STAND.md §5: names, parameters, units, ranges, defaults.
 
-Every parameter has two ranges:
+Every parameter has three ranges:
 
-* ``low``–``high``: where a real stand's value plausibly lies when the effect is present;
-  fitting bounds and random draws (``EffectInfo.draw``) use it;
+* ``bounds``: what physics and the stand allow (the reason is in ``why`` and in
+  docs/effects.md); a diagnosis fits within them, and a fit that ends on one is reported
+  "at its bound" (the effect may be larger, or of another form);
+* ``low``–``high``: a typical magnitude, clearly visible in the recordings: the check's
+  random draws (``EffectInfo.draw``) and the screening probes use it;
 * ``minimum``–``maximum``: what the model admits at all (zero magnitudes included);
   ``EffectSpec.resolved`` and ``parse_effect`` refuse values outside it.
 
@@ -52,15 +55,29 @@ class ParamInfo:
     description: str
     column: int  # index in the kernel's parameter row
     fit: bool = True  # worth fitting in a diagnosis (else a fixed physical constant)
-    log: bool = False  # spans decades: draw and fit on a log scale
+    #: Spans decades: drawn and fitted on a log scale; a signed one on a symmetric log
+    #: scale (asinh of the value over a quarter of the typical magnitude).
+    log: bool = False
     drawn: bool | None = None  # varies between drawn stands (None: as ``fit``)
+    bounds: tuple[float, float] = (0.0, 0.0)  # physical range: fitting bounds
+    why: str = ""  # why the physical range is what it is
+
+    @property
+    def fit_low(self) -> float:
+        """Lower fitting bound (the physical range; the typical range if none is given)."""
+        return self.bounds[0] if self.bounds != (0.0, 0.0) else self.low
+
+    @property
+    def fit_high(self) -> float:
+        """Upper fitting bound."""
+        return self.bounds[1] if self.bounds != (0.0, 0.0) else self.high
 
     @property
     def varies(self) -> bool:
         """Drawn at random for a check's "real" stand."""
         return self.fit if self.drawn is None else self.drawn
 
-    def to_dict(self) -> dict[str, float | str | bool]:
+    def to_dict(self) -> dict[str, float | str | bool | list[float]]:
         """Plain values (for JSON)."""
         return {
             "name": self.name,
@@ -72,6 +89,8 @@ class ParamInfo:
             "maximum": self.maximum,
             "fit": self.fit,
             "log": self.log,
+            "bounds": [self.fit_low, self.fit_high],
+            "why": self.why,
             "description": self.description,
         }
 
@@ -105,7 +124,7 @@ class EffectInfo:
         for p in self.params:
             if not p.varies:
                 continue
-            if p.log and p.low > 0:
+            if p.log and p.low > 0 and p.high > 0:
                 values[p.name] = float(math.exp(rng.uniform(math.log(p.low), math.log(p.high))))
             else:
                 values[p.name] = float(rng.uniform(p.low, p.high))
@@ -143,12 +162,6 @@ class EffectSpec:
                     f"[{p.minimum:g}, {p.maximum:g}]{unit}"
                 )
             values[key] = value
-        if self.name == "fibre_pulley_jump" and abs(values["step_m"]) > values["depth_scale_m"]:
-            raise EffectError(
-                f"fibre_pulley_jump: |step_m| = {abs(values['step_m']):g} m must not exceed "
-                f"depth_scale_m = {values['depth_scale_m']:g} m (the seat moves no faster "
-                "than the slack grows)"
-            )
         return values
 
     def __str__(self) -> str:
@@ -159,9 +172,10 @@ class EffectSpec:
 # fmt: off
 def _p(name: str, unit: str, default: float, plausible: tuple[float, float],
        admissible: tuple[float, float], column: int, description: str, *,
-       fit: bool = True, log: bool = False, drawn: bool | None = None) -> ParamInfo:
+       fit: bool = True, log: bool = False, drawn: bool | None = None,
+       bounds: tuple[float, float] = (0.0, 0.0), why: str = "") -> ParamInfo:
     return ParamInfo(name, unit, default, *plausible, *admissible, description, column, fit, log,
-                     drawn)
+                     drawn, bounds, why)
 
 
 _INFOS = (
@@ -173,9 +187,14 @@ _INFOS = (
         ek.R_VE_ON,
         (
             _p("branch_stiffness_n_m", "N/m", 2.0e4, (3.0e3, 6.0e4), (0.0, 1.0e6), ek.R_VE_K,
-               "k₂, stiffness of the Maxwell branch (whole fibre)", log=True),
+               "k₂, stiffness of the Maxwell branch (whole fibre)", log=True,
+               bounds=(5.0e2, 2.0e5),
+               why="a polymer-matrix fibre's dynamic stiffness exceeds its static one by a "
+                   "few per cent up to several times (k is 34–94 kN/m)"),
             _p("relaxation_time_s", "s", 0.03, (5.0e-3, 0.1), (5.0e-4, 10.0), ek.R_VE_TAU,
-               "τ = c₂/k₂, the branch's relaxation time", log=True),
+               "τ = c₂/k₂, the branch's relaxation time", log=True, bounds=(5.0e-4, 1.0),
+               why="faster than one 2 kHz sample it is plain damping; slower than the slowest "
+                   "cycle (≈ 1–2.5 s) it is extra stiffness that k absorbs"),
         ),
     ),
     EffectInfo(
@@ -186,9 +205,15 @@ _INFOS = (
         ek.R_TV_ON,
         (
             _p("damping_ratio", "1", 0.02, (0.005, 0.1), (1.0e-4, 1.0), ek.R_TV_ZETA,
-               "modal damping ratio of the string modes (at rest tension)", log=True),
+               "modal damping ratio of the string modes (at rest tension)", log=True,
+               bounds=(1.0e-3, 0.3),
+               why="carbon fibre's internal damping is 0.1–1 %; air drag on a slack filament "
+                   "bundle adds up to tens of per cent"),
             _p("load_scale", "1", 1.0, (0.5, 2.0), (0.0, 10.0), ek.R_TV_LOAD,
-               "multiplier on gravity's transverse load on the spans (0: never excited)"),
+               "multiplier on gravity's transverse load on the spans (0: never excited)",
+               bounds=(0.1, 5.0),
+               why="drafts, guide misalignment and pulley run-out excite the spans several "
+                   "times more than gravity alone; below 0.1 the modes stay in the noise"),
             _p("drive_span_tilt_deg", "deg", 5.0, (0.0, 15.0), (0.0, 90.0), ek.R_TV_TILT,
                "tilt of the (vertical) drive span from the vertical", fit=False),
         ),
@@ -201,9 +226,15 @@ _INFOS = (
         ek.R_PJ_ON,
         (
             _p("step_m", "m", 2.0e-4, (1.0e-4, 5.0e-4), (-2.0e-3, 2.0e-3), ek.R_PJ_STEP,
-               "length change of the second seat (+: effective fibre shorter)"),
+               "length change of the second seat (+: effective fibre shorter)", log=True,
+               bounds=(-3.0e-3, 3.0e-3),
+               why="re-seating across an 80 mm pulley's groove or onto its flange changes the "
+                   "fibre path by up to a few millimetres, either way"),
             _p("depth_scale_m", "m", 1.0e-3, (5.0e-4, 5.0e-3), (1.0e-5, 0.1), ek.R_PJ_DEPTH,
-               "slack depth over which the fibre completes its jump", log=True),
+               "slack depth over which the fibre completes its jump", log=True,
+               bounds=(1.0e-4, 3.0e-2),
+               why="from a loop as deep as the groove (0.1 mm) to one as high as the flange "
+                   "(a few cm)"),
         ),
     ),
     EffectInfo(
@@ -214,11 +245,17 @@ _INFOS = (
         ek.R_PI_ON,
         (
             _p("inertia_kg_m2", "kg·m²", 1.1e-4, (3.0e-5, 3.0e-4), (1.0e-6, 1.0e-2), ek.R_PI_J,
-               "pulley moment of inertia", log=True),
+               "pulley moment of inertia", log=True, bounds=(1.0e-5, 2.0e-3),
+               why="an 80 mm aluminium disc 5–10 mm thick has 6e-5–1.1e-4 kg·m²; steel, a "
+                   "hub and a shaft raise it to about 1e-3"),
             _p("bearing_torque_n_m", "N·m", 0.01, (0.002, 0.03), (0.0, 0.5), ek.R_PI_TORQUE,
-               "load-independent bearing friction torque M₀"),
+               "load-independent bearing friction torque M₀", bounds=(0.0, 0.1),
+               why="a clean ball bearing has about 1e-3 N·m; seals, a plain bush or dirt raise "
+                   "it to 0.05–0.1 N·m"),
             _p("load_coeff", "1", 0.005, (0.0, 0.02), (0.0, 0.2), ek.R_PI_LOAD,
-               "bearing friction at the rim per newton of hub load (T₁ + T₂)·sin(φ/2)"),
+               "bearing friction at the rim per newton of hub load (T₁ + T₂)·sin(φ/2)",
+               bounds=(0.0, 0.05),
+               why="bore friction μ 0.001–0.2 (rolling to plain) times bore/rim radius ≈ 0.25"),
             _p("presliding_m", "m", 1.0e-5, (2.0e-6, 5.0e-5), (1.0e-7, 1.0e-3), ek.R_PI_PRESLIDE,
                "rim displacement before the bearing slides (at rest load)", fit=False, log=True),
         ),
@@ -231,9 +268,13 @@ _INFOS = (
         ek.R_SS_ON,
         (
             _p("static_ratio", "1", 0.4, (0.1, 0.8), (0.0, 5.0), ek.R_SS_RATIO,
-               "r: static friction exceeds kinetic by this fraction"),
+               "r: static friction exceeds kinetic by this fraction", bounds=(0.0, 3.0),
+               why="static/kinetic friction ratios of steel on lubricated or dry guides lie "
+                   "between 1 and about 4"),
             _p("stribeck_speed_m_s", "m/s", 3.0e-3, (1.0e-3, 1.0e-2), (1.0e-5, 1.0), ek.R_SS_VS,
-               "v_s: speed over which friction falls to kinetic", log=True),
+               "v_s: speed over which friction falls to kinetic", log=True,
+               bounds=(1.0e-4, 0.1),
+               why="lubricated line contacts show Stribeck speeds from 0.1 mm/s to 0.1 m/s"),
             _p("bristle_stiffness_n_m", "N/m", 1.0e5, (3.0e4, 3.0e5), (1.0e3, 1.0e7),
                ek.R_SS_SIGMA, "σ₀, presliding stiffness (σ₁ = 2√(σ₀m))", fit=False, log=True),
         ),
@@ -246,7 +287,8 @@ _INFOS = (
         ek.R_SL_ON,
         (
             _p("friction_coeff", "1", 0.1, (0.03, 0.3), (0.0, 2.0), ek.R_SL_MU,
-               "μ_s, friction coefficient of the guide wall"),
+               "μ_s, friction coefficient of the guide wall", bounds=(0.0, 0.8),
+               why="steel or aluminium on a dry guide wall: up to 0.6–0.8"),
         ),
     ),
     EffectInfo(
@@ -256,7 +298,9 @@ _INFOS = (
         ek.R_DG_ON,
         (
             _p("gain_error", "1", 0.02, (-0.04, 0.04), (-0.5, 0.5), ek.R_DG_GAIN,
-               "relative gain error of the dial gauge"),
+               "relative gain error of the dial gauge", bounds=(-0.2, 0.2),
+               why="a gauge mounted at an angle to the incline reads u/cos θ (15 % at 30°); "
+                   "a lever gauge's arm angle and a mis-set scale add a few per cent"),
             # Not fitted: recordings count u from their rest reading, which removes it;
             # under multiple shooting a fitted offset would pose as a fibre length change.
             # Still drawn, so the check shows it is harmless.
@@ -271,9 +315,12 @@ _INFOS = (
         ek.R_CS_ON,
         (
             _p("force_skew_s", "s", 1.0e-3, (-3.0e-3, 3.0e-3), (-0.05, 0.05), ek.R_CS_FORCE,
-               "delay of the force channel"),
+               "delay of the force channel", log=True, bounds=(-0.025, 0.025),
+               why="separate buffers, serial latency and filter delays: up to 50 samples "
+                   "(25 ms) either way at 2 kHz"),
             _p("displacement_skew_s", "s", 0.0, (-3.0e-3, 3.0e-3), (-0.05, 0.05), ek.R_CS_DISP,
-               "delay of the displacement channel"),
+               "delay of the displacement channel", log=True, bounds=(-0.025, 0.025),
+               why="as the force channel's"),
         ),
     ),
     EffectInfo(
@@ -283,9 +330,13 @@ _INFOS = (
         ek.R_FG_ON,
         (
             _p("cutoff_hz", "Hz", 80.0, (30.0, 300.0), (1.0, 1.0e5), ek.R_FG_FC,
-               "natural frequency ω/2π of the low-pass", log=True),
+               "natural frequency ω/2π of the low-pass", log=True, bounds=(5.0, 2000.0),
+               why="strain-gauge amplifiers filter at 10 Hz to a few kHz; above 1 kHz a "
+                   "2 kHz recording cannot see it"),
             _p("damping_ratio", "1", 0.7, (0.5, 1.2), (0.05, 10.0), ek.R_FG_ZETA,
-               "ζ of the low-pass (≥ 1: no overshoot, first-order-like)"),
+               "ζ of the low-pass (≥ 1: no overshoot, first-order-like)", bounds=(0.2, 3.0),
+               why="a lightly damped load cell 0.2; Butterworth/Bessel filters 0.7–0.9; "
+                   "cascaded RC stages overdamped"),
         ),
     ),
 )

@@ -90,9 +90,12 @@ class RankedEffect:
     #: Held-out error in noise units (what the score is made of; 1 = perfect).
     heldout_excess: float | None = None
     params: dict[str, float] = field(default_factory=dict)
+    #: Fitted parameters that ended on a bound of their physical range: the effect may be
+    #: larger than the range allows, or of another form.
+    at_bound: list[str] = field(default_factory=list)
 
     def to_dict(self) -> dict[str, object]:
-        """JSON keys effect, score, heldout_error, heldout_excess, screening, params."""
+        """JSON keys effect, score, heldout_error, heldout_excess, screening, params, at_bound."""
         return {
             "effect": self.effect,
             "score": self.score,
@@ -100,6 +103,7 @@ class RankedEffect:
             "heldout_excess": self.heldout_excess,
             "screening": self.screening,
             "params": self.params,
+            "at_bound": self.at_bound,
         }
 
 
@@ -321,6 +325,7 @@ def diagnose(
             line.heldout_error = heldout_error(traces, outs)
             line.heldout_excess = x_aug
             line.params = _effect_params(effect, res.values)
+            line.at_bound = _at_bound(res)
         ranking.append(line)
     ranking.sort(key=lambda r: (r.score is None, -(r.score or 0.0), -r.screening))
 
@@ -364,6 +369,7 @@ def diagnose(
             if polished.train_cost < res.train_cost:
                 outs = _outputs(polished.candidate, polished.values, traces, nominal)
                 best.params = _effect_params(chosen, polished.values)
+                best.at_bound = _at_bound(polished)
             after_out = outs
     x_after = heldout_excess(traces, after_out)
     timings["total"] = time.perf_counter() - t0
@@ -389,3 +395,13 @@ def diagnose(
 def _effect_params(effect: str, values: dict[str, float]) -> dict[str, float]:
     prefix = f"{effect}."
     return {k[len(prefix) :]: v for k, v in values.items() if k.startswith(prefix)}
+
+
+def _at_bound(res: FitResult) -> list[str]:
+    """The effect's parameters (names without the effect prefix) that ended on a bound."""
+    prefix = f"{res.candidate.effect}."
+    return [
+        p.name[len(prefix) :]
+        for p in res.candidate.params
+        if p.name.startswith(prefix) and p.at_bound(res.values[p.name])
+    ]

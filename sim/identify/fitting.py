@@ -24,7 +24,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import least_squares
 
-from sim.effects import EFFECTS, EffectSpec
+from sim.effects import EFFECTS, EffectSpec, ParamInfo
 from sim.identify.traces import Trace
 from sim.model import Model, Variant
 from sim.params import StandParams
@@ -42,16 +42,25 @@ BASELINE_PARAMS = (
 
 @dataclass(frozen=True)
 class FreeParam:
-    """One fitted parameter: its bounds in natural units and whether it is fitted in log."""
+    """One fitted parameter: its bounds in natural units and the optimiser's scale.
+
+    ``scale``: "lin", "log" (positive, spanning decades) or "asinh" (signed, spanning
+    decades: z = asinh(value / width), log-like away from zero, linear through it).
+    """
 
     name: str  # "stiffness_scale", or "<effect>.<param>"
     low: float
     high: float
-    log: bool
+    scale: str = "lin"
+    width: float = 1.0
 
     def to_internal(self, value: float) -> float:
         """Natural value → optimiser coordinate."""
-        return float(np.log(value)) if self.log else value
+        if self.scale == "log":
+            return float(np.log(value))
+        if self.scale == "asinh":
+            return float(np.arcsinh(value / self.width))
+        return value
 
     def bounds(self) -> tuple[float, float]:
         """Optimiser bounds."""
@@ -59,7 +68,28 @@ class FreeParam:
 
     def to_natural(self, z: float) -> float:
         """Optimiser coordinate → natural value."""
-        return float(np.exp(z)) if self.log else z
+        if self.scale == "log":
+            return float(np.exp(z))
+        if self.scale == "asinh":
+            return float(self.width * np.sinh(z))
+        return z
+
+    def at_bound(self, value: float, share: float = 2e-3) -> bool:
+        """Whether a fitted value ended on a bound (within ``share`` of the range)."""
+        lo, hi = self.bounds()
+        z = self.to_internal(value)
+        return bool(z <= lo + share * (hi - lo) or z >= hi - share * (hi - lo))
+
+
+def _free(effect: str, p: ParamInfo) -> FreeParam:
+    """An effect parameter as fitted: within its physical range (``ParamInfo.bounds``)."""
+    low, high = p.fit_low, p.fit_high
+    if p.log and low > 0:
+        return FreeParam(f"{effect}.{p.name}", low, high, "log")
+    if p.log:  # signed, spanning decades
+        width = max(abs(p.low), abs(p.high)) / 4
+        return FreeParam(f"{effect}.{p.name}", low, high, "asinh", width)
+    return FreeParam(f"{effect}.{p.name}", low, high)
 
 
 @dataclass
@@ -72,12 +102,9 @@ class Candidate:
     @classmethod
     def build(cls, effect: str | None) -> Candidate:
         """Free parameters for a candidate: the baseline's and the effect's fitted ones."""
-        params = [FreeParam(n, lo, hi, lg) for n, lo, hi, lg in BASELINE_PARAMS]
+        params = [FreeParam(n, lo, hi, "log" if lg else "lin") for n, lo, hi, lg in BASELINE_PARAMS]
         if effect is not None:
-            for p in EFFECTS[effect].params:
-                if p.fit:
-                    low = max(p.minimum, min(p.low, 0.0)) if not p.log else p.low
-                    params.append(FreeParam(f"{effect}.{p.name}", low, p.high, p.log and p.low > 0))
+            params += [_free(effect, p) for p in EFFECTS[effect].params if p.fit]
         return cls(effect, params)
 
     @property

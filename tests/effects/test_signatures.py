@@ -190,6 +190,30 @@ def test_pulley_jump_changes_the_fibre_length_only_across_slack_episodes(
     assert np.array_equal(slow_run.u_m, slow_base.u_m)
 
 
+def test_a_large_fast_seat_change_moves_no_further_than_the_slack(stand: StandConfig) -> None:
+    # A seat 2 mm away reached within 0.1 mm of slack: each episode's change of length is
+    # bounded by how deep the slack got (the fibre cannot re-seat further than its loop).
+    x, mass = situation_drive(stand, "11")
+    spec = EffectSpec("fibre_pulley_jump", {"step_m": 2e-3, "depth_scale_m": 1e-4})
+    p, _, run = _pair(stand, x, mass, spec)
+    rel = x - x[0]
+    xd = np.concatenate([[0.0], np.diff(rel) * RATE])
+    n = p.projection
+    length = (run.force_n - p.damping_n_s_m * (xd - n * run.v_m_s)) / p.stiffness_n_m
+    length -= p.preload_m + rel - n * run.u_m
+    taut = run.force_n > 0
+    phase = np.cumsum(np.diff(taut.astype(int), prepend=1) == 1)
+    levels = [length[taut & (phase == k)].mean() for k in np.unique(phase[taut])]
+    changes = np.abs(np.diff(levels))
+    assert changes.max() > 1e-4  # it does jump …
+    for k, change in enumerate(changes):  # … by no more than the slack before it
+        episode = ~taut & (phase == k)  # the slack after taut phase k
+        depth = np.max(-(p.preload_m + rel[episode] - n * run.u_m[episode] + levels[k]))
+        # Sampled at 2 kHz the deepest slack is underestimated a little; unbounded, the
+        # change would be ≈ 2 mm, several times the depth.
+        assert change <= 1.2 * depth
+
+
 # --- pulley and guide -----------------------------------------------------------------
 
 
