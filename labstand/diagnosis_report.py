@@ -61,10 +61,15 @@ def _ranking_plot(path: Path, result: Diagnosis) -> None:
     ax.barh(y + 0.2, screening, height=0.4, color="tab:gray", label="screening (residual share)")
     ax.barh(y - 0.2, scores, height=0.4, color="tab:green", label="held-out gap closure (refitted)")
     ax.set_yticks(y, names)
-    ax.axvline(result.closure_needed, color="k", ls=":", lw=0.8, label="closure needed")
+    named = {e.effect for e in result.effects}
+    for tick, name in zip(ax.get_yticklabels(), names, strict=True):
+        if name in named:
+            tick.set_fontweight("bold")
     ax.set_xlim(min(0.0, *scores) - 0.05, 1.05)
     ax.legend(fontsize=8, loc="lower right")
-    ax.set_title(f"Ranking — answer: {result.effect}")
+    answer = " + ".join(e.effect for e in result.effects) or "none"
+    ax.set_xlabel("share (1 = all of the residual / all of the gap above the noise)")
+    ax.set_title(f"Ranking (each alone) — answer: {answer} (named in bold)")
     fig.savefig(path, dpi=90)
     plt.close(fig)
 

@@ -105,6 +105,20 @@ def run(args: argparse.Namespace) -> int:
 
 def _print_summary(result: Diagnosis, report: Path | None) -> None:
     print(f"Effect: {result.effect}")
+    for e in result.effects:
+        notes = []
+        if e.at_bound:
+            notes.append(
+                f"{', '.join(e.at_bound)} at its bound: the effect may be larger or of another form"
+            )
+        if e.indistinguishable_from:
+            notes.append(
+                f"the recordings cannot tell it from {', '.join(e.indistinguishable_from)}"
+            )
+        params = ", ".join(f"{k} = {v:.4g}" for k, v in e.params.items())
+        print(f"  {e.effect}: closes {e.closure:.0%} of the gap (p = {e.p_value:.2g}); {params}")
+        for note in notes:
+            print(f"    {note}")
     print("Held-out gap        before            after")
     for ch in ("u", "F"):
         b, a = result.gap_before[ch], result.gap_after[ch]

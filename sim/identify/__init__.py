@@ -1,4 +1,7 @@
-"""Sim-to-real gap diagnosis: where the gap lies, which effect explains it, how far it shrinks.
+"""Sim-to-real gap diagnosis: where the gap lies, which effects explain it, how far it shrinks.
+
+System identification on arrays (``Trace``): no file is read here; ``labstand`` reads the
+recordings and hands their series over.
 
 Exceptions::
 
@@ -6,7 +9,8 @@ Exceptions::
      └── DiagnosisInputError   recordings that cannot be diagnosed (says what is missing)
 """
 
-from sim.identify.diagnose import Diagnosis, diagnose
+from sim.identify.diagnose import diagnose
+from sim.identify.report import Diagnosis
 from sim.identify.traces import DiagnosisInputError, Trace, make_trace
 
 __all__ = ["Diagnosis", "DiagnosisInputError", "Trace", "diagnose", "make_trace"]

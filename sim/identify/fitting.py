@@ -94,32 +94,36 @@ def _free(effect: str, p: ParamInfo) -> FreeParam:
 
 @dataclass
 class Candidate:
-    """The baseline plus at most one effect, with its free parameters."""
+    """The baseline plus some effects (none, one, or a second on top), and their free params."""
 
-    effect: str | None
+    effects: tuple[str, ...] = ()
     params: list[FreeParam] = field(default_factory=list)
 
     @classmethod
-    def build(cls, effect: str | None) -> Candidate:
-        """Free parameters for a candidate: the baseline's and the effect's fitted ones."""
+    def build(cls, *effects: str) -> Candidate:
+        """Free parameters for a candidate: the baseline's and the effects' fitted ones."""
         params = [FreeParam(n, lo, hi, "log" if lg else "lin") for n, lo, hi, lg in BASELINE_PARAMS]
-        if effect is not None:
+        for effect in effects:
             params += [_free(effect, p) for p in EFFECTS[effect].params if p.fit]
-        return cls(effect, params)
+        return cls(tuple(effects), params)
+
+    @property
+    def effect(self) -> str | None:
+        """The newest effect (the one this candidate adds), None for the baseline."""
+        return self.effects[-1] if self.effects else None
 
     @property
     def name(self) -> str:
-        """The effect's name, or 'none' for the baseline."""
-        return self.effect or "none"
+        """The effects' names joined by '+', or 'none' for the baseline."""
+        return "+".join(self.effects) or "none"
 
     def natural(self, z: FloatArray) -> dict[str, float]:
         """Optimiser vector → named natural values."""
         return {p.name: p.to_natural(float(v)) for p, v in zip(self.params, z, strict=True)}
 
     def model(self, nominal: StandParams, mass_kg: float) -> Model:
-        """The candidate's model: the nominal stand at this mass, with its effect."""
-        effects = [EffectSpec(self.effect)] if self.effect is not None else []
-        return Model(nominal.with_(mass_kg=mass_kg), effects)
+        """The candidate's model: the nominal stand at this mass, with its effects."""
+        return Model(nominal.with_(mass_kg=mass_kg), [EffectSpec(e) for e in self.effects])
 
     def variant(self, nominal: StandParams, values: dict[str, float]) -> Variant:
         """The model parameters a set of fitted values describes."""
@@ -128,16 +132,15 @@ class Candidate:
             "damping_n_s_m": nominal.damping_n_s_m * values["damping_scale"],
             "friction_scale": nominal.friction_scale * values["friction_scale"],
         }
-        if self.effect is not None:
-            prefix = f"{self.effect}."
-            changes.update({k: v for k, v in values.items() if k.startswith(prefix)})
+        prefixes = tuple(f"{e}." for e in self.effects)
+        changes.update({k: v for k, v in values.items() if k.startswith(prefixes)})
         return changes
 
     def start_points(self, baseline: dict[str, float] | None) -> list[FloatArray]:
         """Deterministic starts: from the baseline fit (or nominal), effect low/mid/default."""
         base = baseline or {"stiffness_scale": 1.0, "damping_scale": 1.0, "friction_scale": 1.0}
         starts = []
-        fractions = (0.5,) if self.effect is None else (0.15, 0.5, 0.85)
+        fractions = (0.5,) if not self.effects else (0.15, 0.5, 0.85)
         for frac in fractions:
             z = []
             for p in self.params:
@@ -334,7 +337,7 @@ def fit(
     hi = np.array([p.bounds()[1] for p in candidate.params])
     best: tuple[float, FloatArray] | None = None
     starts = candidate.start_points(baseline)
-    if candidate.effect is None and baseline is None:
+    if not candidate.effects and baseline is None:
         starts = _grid_starts(objective)
     if single_start and baseline is not None:
         starts = [

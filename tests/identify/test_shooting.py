@@ -127,7 +127,7 @@ def test_a_dial_gauge_candidate_starts_from_the_true_displacement(stand: StandCo
     # And the candidate then predicts the recording to noise level, the baseline does not.
     nominal = stand.stand_params("final", 8.131)
     _, f = simulate_values(cand, [values], tr, nominal)
-    _, fb = simulate_values(Candidate.build(None), [BASE], tr, nominal)
+    _, fb = simulate_values(Candidate.build(), [BASE], tr, nominal)
     spread = np.ptp(tr.force_n)
     assert np.max(np.abs(f[0] - tr.force_n)) < 0.05 * spread
     assert np.max(np.abs(fb[0] - tr.force_n)) > 0.1 * spread
@@ -138,7 +138,7 @@ def test_shooting_tames_the_light_weights_chaos(stand: StandConfig) -> None:
     tr, _ = _trace(stand, 3.096, [])
     nominal = stand.stand_params("final", 3.096)
     sets = [BASE, dict(BASE, stiffness_scale=1.0 + 1e-6)]
-    u, _ = simulate_values(Candidate.build(None), sets, tr, nominal)
+    u, _ = simulate_values(Candidate.build(), sets, tr, nominal)
     assert np.max(np.abs(u[0] - u[1])) < 1e-7
 
 

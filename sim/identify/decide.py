@@ -1,0 +1,79 @@
+"""The decision: whether a candidate's held-out gain is evidence of an effect or luck.
+
+Every candidate is refitted on the training cycles and judged on the held-out ones, per
+held-out block (a quarter second of a held-out cycle): the drop in mean squared error in
+noise units (``block_improvements``). Under "no effect" — the candidate only moved
+parameters that noise and the baseline's own parameter error let it move — held-out
+gains scatter around zero, symmetric or worse (a refit that follows training noise
+predicts held-out cycles worse). So the evidence is a one-sided Wilcoxon signed-rank test
+of the blocks' gains against zero: its p-value is the chance of gains this consistent
+from noise alone, without assuming how large they are where the effect shows and where
+it does not (a t-test over blocks of very unequal gains had no power with three held-out
+cycles, a sample-level test none of the calibration: neighbouring samples are not
+independent). Choosing the best of m candidates is m tests, so
+its p-value is multiplied by m (Bonferroni) before it is compared with ``ALPHA``; then the
+false-alarm rate of a ``none`` campaign is at most ``ALPHA`` by construction, whatever
+the noise level, rather than tuned by a closure threshold.
+
+A gain must also exceed ``MIN_GAIN_OVER_NOISE`` in X (RMS error in noise units): the
+resolution of X itself (the rest noise it is measured in is estimated from the rest
+before the motion), below which no model difference is meaningful.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.stats import wilcoxon
+
+from sim.identify.heldout import Outputs, block_improvements, heldout_excess
+from sim.identify.traces import Trace
+
+#: Family-wise false-alarm rate of one decision (after the Bonferroni correction).
+ALPHA = 0.01
+#: Least improvement of X (held-out RMS error in noise units) that counts at all.
+MIN_GAIN_OVER_NOISE = 0.1
+
+__all__ = ["ALPHA", "MIN_GAIN_OVER_NOISE", "Evidence", "compare"]
+
+
+@dataclass(frozen=True)
+class Evidence:
+    """How a candidate compares with a reference model on the held-out cycles."""
+
+    x_before: float  # reference's held-out error, noise units (1 = perfect)
+    x_after: float  # candidate's
+    p_value: float  # one-sided, single test: block gains centred on ≤ 0
+    blocks: int
+
+    @property
+    def gain(self) -> float:
+        """Drop of X, noise units."""
+        return self.x_before - self.x_after
+
+    def accepted(self, tests: int, alpha: float = ALPHA) -> bool:
+        """Evidence of an effect when it was the best of ``tests`` candidates."""
+        return self.p_value * max(tests, 1) <= alpha and self.gain >= MIN_GAIN_OVER_NOISE
+
+
+def p_value_of_gains(gains: np.ndarray) -> float:
+    """One-sided p of "block gains are centred on ≤ 0" (Wilcoxon signed-rank)."""
+    nonzero = gains[gains != 0.0]
+    if nonzero.size < 2:
+        return 1.0
+    return float(wilcoxon(nonzero, alternative="greater").pvalue)
+
+
+def compare(
+    traces: Sequence[Trace], before: Sequence[Outputs], after: Sequence[Outputs]
+) -> Evidence:
+    """The held-out evidence that ``after`` predicts better than ``before``."""
+    gains = block_improvements(traces, before, after)
+    return Evidence(
+        x_before=heldout_excess(traces, before),
+        x_after=heldout_excess(traces, after),
+        p_value=p_value_of_gains(gains),
+        blocks=int(gains.size),
+    )

@@ -1,0 +1,127 @@
+"""The diagnosis as a typed report: what the CLI prints, the JSON, and the HTML page read."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+from sim.identify.decide import ALPHA
+from sim.identify.heldout import Outputs
+from sim.identify.where import Where
+
+__all__ = ["AcceptedEffect", "ChannelGap", "Diagnosis", "RankedEffect"]
+
+#: Per channel (``u``, ``F``): R, psi and NRMSE on the held-out samples.
+ChannelGap = dict[str, dict[str, float]]
+
+
+@dataclass
+class RankedEffect:
+    """One candidate's line in the ranking (each alone on top of the baseline)."""
+
+    effect: str
+    #: Share of the baseline residual the screening probe explained.
+    screening: float
+    #: Held-out gap closure; None when the candidate was not refitted.
+    score: float | None = None
+    #: Held-out RMS of the channels' NRMSE.
+    heldout_error: float | None = None
+    #: Held-out error in noise units (what the score is made of; 1 = perfect).
+    heldout_excess: float | None = None
+    #: One-sided p-value of its held-out gain over the baseline (single test).
+    p_value: float | None = None
+    params: dict[str, float] = field(default_factory=dict)
+    #: Fitted parameters that ended on a bound of their physical range: the effect may be
+    #: larger than the range allows, or of another form.
+    at_bound: list[str] = field(default_factory=list)
+
+    def to_dict(self) -> dict[str, object]:
+        """JSON keys effect, score, heldout_error, heldout_excess, p_value, screening, ..."""
+        return {
+            "effect": self.effect,
+            "score": self.score,
+            "heldout_error": self.heldout_error,
+            "heldout_excess": self.heldout_excess,
+            "p_value": self.p_value,
+            "screening": self.screening,
+            "params": self.params,
+            "at_bound": self.at_bound,
+        }
+
+
+@dataclass
+class AcceptedEffect:
+    """An effect the diagnosis names, in the order it was accepted.
+
+    ``closure`` is the share of the baseline's gap above the noise that adding this effect
+    (on top of those before it) closed on held-out cycles; ``p_value`` its test against
+    the model before it, corrected for the number of candidates tried at that step.
+    ``indistinguishable_from``: candidates that explain the same part of the gap about
+    as well — the recordings cannot tell them apart from this one.
+    """
+
+    effect: str
+    closure: float
+    p_value: float
+    params: dict[str, float]
+    at_bound: list[str] = field(default_factory=list)
+    indistinguishable_from: list[str] = field(default_factory=list)
+
+    def to_dict(self) -> dict[str, object]:
+        """JSON keys effect, closure, p_value, params, at_bound, indistinguishable_from."""
+        return {
+            "effect": self.effect,
+            "closure": self.closure,
+            "p_value": self.p_value,
+            "params": self.params,
+            "at_bound": self.at_bound,
+            "indistinguishable_from": self.indistinguishable_from,
+        }
+
+
+@dataclass
+class Diagnosis:
+    """The answer: the typed report the CLI and the HTML page both read (``to_dict``: JSON)."""
+
+    effects: list[AcceptedEffect]
+    ranking: list[RankedEffect]
+    where: Where
+    gap_before: ChannelGap
+    gap_after: ChannelGap
+    baseline: dict[str, float]
+    heldout_error_before: float
+    heldout_error_after: float
+    noise_floor: float
+    gap_closure: float
+    confidence: float
+    #: Family-wise false-alarm rate of each decision.
+    alpha: float = ALPHA
+    timings_s: dict[str, float] = field(default_factory=dict)
+    simulations: int = 0
+    outputs_before: list[Outputs] = field(default_factory=list, repr=False)
+    outputs_after: list[Outputs] = field(default_factory=list, repr=False)
+
+    @property
+    def effect(self) -> str:
+        """The strongest effect (the first accepted), or ``none``."""
+        return self.effects[0].effect if self.effects else "none"
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON keys: effect, effects, ranking, where, gap_before, gap_after, and details."""
+        return {
+            "effect": self.effect,
+            "effects": [e.to_dict() for e in self.effects],
+            "ranking": [r.to_dict() for r in self.ranking],
+            "where": self.where.to_dict(),
+            "gap_before": self.gap_before,
+            "gap_after": self.gap_after,
+            "baseline_fit": self.baseline,
+            "heldout_error_before": self.heldout_error_before,
+            "heldout_error_after": self.heldout_error_after,
+            "noise_floor": self.noise_floor,
+            "gap_closure": self.gap_closure,
+            "alpha": self.alpha,
+            "confidence": self.confidence,
+            "simulations": self.simulations,
+            "timings_s": self.timings_s,
+        }
