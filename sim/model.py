@@ -86,6 +86,12 @@ class Restarts:
     u_m, v_m_s, force_n
         The recorded channels at every sample (smoothed): u (m), its rate (m/s), F (N).
         A segment starting at sample 0 starts from static rest instead.
+    dial_slope
+        How far the recorded u moves per metre of drive at constant force on a calm taut
+        fibre (NaN: unknown). With the model's projection n it gives the displacement
+        gauge's scale G = slope·n; every segment restarts from u/G, so a gauge's scale
+        error stays in the u channel (the model's gauge effect then maps u to the
+        reading) instead of becoming a wrong elongation, a wrong force.
     """
 
     starts: IntArray
@@ -93,6 +99,7 @@ class Restarts:
     u_m: FloatArray
     v_m_s: FloatArray
     force_n: FloatArray
+    dial_slope: float = float("nan")
 
 
 class Model:
@@ -233,7 +240,7 @@ class Model:
         base, rows = self._rows(variants, augmented=True)  # the start states need them
         init = _starts.start_states(
             rows, x_rel, rate_hz, restarts.starts, restarts.u_m, restarts.v_m_s,
-            restarts.force_n,
+            restarts.force_n, restarts.dial_slope,
         )  # fmt: skip
         table = self.stand.friction
         starts, lengths = restarts.starts, restarts.lengths

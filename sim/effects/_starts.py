@@ -1,10 +1,12 @@
 """Segment start states from measurements, per kernel row (private: ``sim.model`` uses it).
 
 A segment of a multiple-shooting run restarts from the state the gauges measured. What
-a gauge reads is not the true state when a candidate says the gauge errs, so a row's
-measurement effects are inverted first: the dial gauge reads (1 + g)·u + offset, so
-u = (u_rec − offset)/(1 + g); a displacement channel recorded Δt late shows the true u
-of Δt earlier, so the true u now is u_rec(t + Δt) ≈ u_rec + Δt·v. The Maxwell branch's
+the dial gauge reads is scaled by its gain G against the drive encoder, which the
+recording itself shows (``Restarts.dial_slope``): every row restarts from u_rec/G, so a
+gain error never becomes a wrong elongation (a wrong force) — it stays in the u channel,
+where a candidate's dial gauge model maps the true u to the reading. A displacement
+channel recorded Δt late shows the true u of Δt earlier, so the true u now is
+u_rec(t + Δt) ≈ u_rec + Δt·v. The Maxwell branch's
 state is its response to the measured elongation history. The other effects' states are
 set inside the kernel (``kernel.measured_state``) or carried between segments.
 """
@@ -31,21 +33,22 @@ def start_states(
     u_m: FloatArray,
     v_m_s: FloatArray,
     force_n: FloatArray,
+    dial_slope: float = float("nan"),
 ) -> FloatArray:
     """Measured start states (sets, segments, ek.N_INIT) for augmented kernel rows.
 
-    ``u_m``, ``v_m_s``, ``force_n``: the recorded channels (smoothed) at every sample.
+    ``u_m``, ``v_m_s``, ``force_n``: the recorded channels (smoothed) at every sample;
+    ``dial_slope``: du_rec/dx at constant force (NaN: take the gauge's scale as 1).
     """
     rows2 = np.atleast_2d(rows)
     u = np.broadcast_to(u_m[starts], (rows2.shape[0], starts.size)).copy()
     v = np.broadcast_to(v_m_s[starts], u.shape).copy()
     skew = np.where(rows2[:, ek.R_CS_ON] > 0, rows2[:, ek.R_CS_DISP], 0.0)[:, None]
     u = u + skew * v
-    dial = rows2[:, ek.R_DG_ON] > 0
-    gain = np.where(dial, 1.0 + rows2[:, ek.R_DG_GAIN], 1.0)[:, None]
-    offset = np.where(dial, rows2[:, ek.R_DG_OFFSET], 0.0)[:, None]
-    u = (u - offset) / gain
-    v = v / gain
+    if np.isfinite(dial_slope) and dial_slope > 0:
+        scale = (dial_slope * rows2[:, ek.P_PROJ])[:, None]
+        u = u / scale
+        v = v / scale
     init = np.zeros((rows2.shape[0], starts.size, ek.N_INIT))
     init[:, :, ek.I_U] = u
     init[:, :, ek.I_V] = v

@@ -19,6 +19,7 @@ The gap is measured on held-out cycles, in noise units.
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import time
 from collections.abc import Callable, Sequence
@@ -40,6 +41,7 @@ from sim.identify.heldout import (
 )
 from sim.identify.report import AcceptedEffect, Diagnosis, RankedEffect
 from sim.identify.screening import outputs_of, screen
+from sim.identify.shooting import dial_slope
 from sim.identify.traces import Trace
 from sim.identify.where import SimStates, where_the_gap_lies
 from sim.params import StandParams
@@ -120,6 +122,10 @@ def diagnose(
     """
     say = progress or (lambda _msg: None)
     pool = list(candidates if candidates is not None else EFFECTS)
+    # One dial gauge for the whole campaign: its scale against the drive, from all
+    # traces, anchors every restart (``shooting.dial_slope``).
+    slope = dial_slope(traces)
+    traces = [dataclasses.replace(tr, dial_slope=slope) for tr in traces]
     timings: dict[str, float] = {}
     t0 = time.perf_counter()
     say("fitting the baseline (stiffness, damping, friction scale)")

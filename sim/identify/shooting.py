@@ -37,6 +37,7 @@ every start state comes from measurements, never from a fitted trajectory.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -76,6 +77,8 @@ class Segments:
         First scored sample per segment (bodies tile the trace: body[k + 1] ends k).
     u_m, v_m_s, force_n
         Smoothed recorded u, its rate and F at every sample (state estimates).
+    dial_slope
+        du/dx at constant force on a calm taut fibre (``dial_slope``), NaN if unknown.
     seg_of, offset
         For every sample of the trace: its segment and index inside that segment's run.
     """
@@ -88,6 +91,7 @@ class Segments:
     force_n: FloatArray
     seg_of: IntArray
     offset: IntArray
+    dial_slope: float = float("nan")
 
     @property
     def count(self) -> int:
@@ -97,7 +101,9 @@ class Segments:
     @property
     def restarts(self) -> Restarts:
         """The segment starts and measured channels, as the model takes them."""
-        return Restarts(self.starts, self.lengths, self.u_m, self.v_m_s, self.force_n)
+        return Restarts(
+            self.starts, self.lengths, self.u_m, self.v_m_s, self.force_n, self.dial_slope
+        )
 
     def assemble(self, runs: FloatArray) -> FloatArray:
         """Segment runs (sets, segments, samples) → one series per set (sets, N)."""
@@ -144,6 +150,25 @@ def segment_trace(
 ) -> Segments:
     """Cut a trace into segments and estimate the measured state along it."""
     rate = trace.rate_hz
+    u_s, v_s, f_s, _ = _smoothed(trace, half_width_s)
+    warm = round(warmup_s * rate)
+    body = _boundaries(f_s, rate, segment_s, warm)
+    starts = np.where(body > 0, np.maximum(body - warm, 0), 0).astype(np.int64)
+    ends = np.append(body[1:], trace.samples)
+    lengths = (ends - starts).astype(np.int64)
+    seg_of = np.repeat(np.arange(body.size), ends - body).astype(np.int64)
+    offset = (np.arange(trace.samples) - starts[seg_of]).astype(np.int64)
+    slope = trace.dial_slope
+    if not np.isfinite(slope):
+        slope = dial_slope([trace])
+    return Segments(starts, lengths, body, u_s, v_s, f_s, seg_of, offset, slope)
+
+
+def _smoothed(
+    trace: Trace, half_width_s: float = STATE_HALF_WIDTH_S
+) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+    """u, du/dt, F and dF/dt from a local cubic fit over ±half_width_s (lost samples bridged)."""
+    rate = trace.rate_hz
     u = _filled(trace.u_m)
     f = _filled(trace.force_n)
     half = max(2, round(half_width_s * rate))
@@ -152,11 +177,55 @@ def segment_trace(
     u_s = savgol_filter(u, window, order, mode="interp")
     v_s = savgol_filter(u, window, order, deriv=1, delta=1.0 / rate, mode="interp")
     f_s = savgol_filter(f, window, order, mode="interp")
-    warm = round(warmup_s * rate)
-    body = _boundaries(f_s, rate, segment_s, warm)
-    starts = np.where(body > 0, np.maximum(body - warm, 0), 0).astype(np.int64)
-    ends = np.append(body[1:], trace.samples)
-    lengths = (ends - starts).astype(np.int64)
-    seg_of = np.repeat(np.arange(body.size), ends - body).astype(np.int64)
-    offset = (np.arange(trace.samples) - starts[seg_of]).astype(np.int64)
-    return Segments(starts, lengths, body, u_s, v_s, f_s, seg_of, offset)
+    f_rate = savgol_filter(f, window, order, deriv=1, delta=1.0 / rate, mode="interp")
+    return u_s, v_s, f_s, f_rate
+
+
+#: Samples with |dF/dt| below this share of its largest value count as calm.
+CALM_SHARE = 0.05
+#: … and with the drive slower than this share of its top speed.
+SLOW_SHARE = 0.2
+
+
+def dial_slope(traces: Sequence[Trace]) -> float:
+    """How far the dial gauge's u moves per metre of drive at constant fibre force.
+
+    On a taut fibre whose force is calm the weight follows the drive quasi-statically:
+    u = (δ₀ + x − F/k)/n, whatever the friction (F is the measured tension itself). So a
+    least-squares fit u ≈ a·x + b·F + c_trace over those samples of all traces (one
+    gauge, one slope; each trace its own zero) gives a = G/n, G the dial gauge's scale
+    against the drive encoder — a gauge that reads 10 % high shows a = 1.1/n — without
+    knowing k (b absorbs it). Samples where the drive moves fast are left out: there a
+    channel skewed in time puts v·Δt into u (a 3 ms skew biased G by 1 % on quick
+    motions; below a fifth of the top speed by a few 0.01 %). The model restarts
+    segments from u/G (``sim.model.Restarts``), so a gauge error stays in the u channel
+    instead of becoming a wrong elongation, hundreds of newtons, in F. NaN with too few
+    such samples or too little drive travel among them.
+    """
+    columns: list[FloatArray] = []
+    targets: list[FloatArray] = []
+    blocks: list[int] = []
+    for trace in traces:
+        u_s, _, f_s, f_rate = _smoothed(trace)
+        x = trace.x_m - trace.x_m[0]
+        taut = f_s > 0.5 * np.median(f_s)
+        calm = np.abs(f_rate) < CALM_SHARE * np.max(np.abs(f_rate))
+        drive_rate = np.abs(np.gradient(x))
+        slow = drive_rate < SLOW_SHARE * np.max(drive_rate)
+        sel = taut & calm & slow & trace.present & np.isfinite(trace.u_m)
+        travel = float(np.ptp(x))
+        if np.count_nonzero(sel) < 200 or travel <= 0 or np.ptp(x[sel]) < 0.3 * travel:
+            continue
+        columns.append(np.column_stack([x[sel], f_s[sel]]))
+        targets.append(u_s[sel])
+        blocks.append(int(np.count_nonzero(sel)))
+    if not blocks:
+        return float("nan")
+    zeros = np.zeros((sum(blocks), len(blocks)))
+    row = 0
+    for j, count in enumerate(blocks):
+        zeros[row : row + count, j] = 1.0
+        row += count
+    design = np.column_stack([np.concatenate(columns), zeros])
+    coef, *_ = np.linalg.lstsq(design, np.concatenate(targets), rcond=None)
+    return float(coef[0])

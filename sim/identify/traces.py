@@ -59,6 +59,9 @@ class Trace:
     noise_u_m: float  # rms of u during the initial rest (sensor noise floor)
     noise_force_n: float
     stroke_m: float
+    #: The campaign's dial gauge slope du/dx at constant force (``shooting.dial_slope``);
+    #: NaN: estimated from this trace alone.
+    dial_slope: float = float("nan")
 
     @property
     def samples(self) -> int:

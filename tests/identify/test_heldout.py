@@ -22,7 +22,7 @@ from sim.identify.traces import Trace
 @pytest.fixture(scope="module")
 def campaign(stand: StandConfig) -> tuple[list[Trace], list[Outputs]]:
     traces, oracle, _ = make_campaign(
-        stand, "none", 8.131, np.random.default_rng(4), SMALL_CAMPAIGN
+        stand, "none", 8.131, np.random.default_rng(4), SMALL_CAMPAIGN, open_loop_oracle=True
     )
     return traces, oracle
 
