@@ -17,12 +17,16 @@ $(STAMP): pyproject.toml requirements.lock
 	$(BIN)/python -m pip install --quiet --no-deps -e .
 	touch $(STAMP)
 
-# A full test on the simulated stand (started and stopped by labstand run itself), then
-# its replay against the model.
+# The main job on the simulated stand: the stand-sim with an effect switched on that the
+# model lacks (a Maxwell branch in the fibre), two tests recorded over the real wire
+# protocols, one replayed against the model, and both diagnosed (HTML report).
+DEMO_EFFECT := fibre_viscoelastic
 demo: $(STAMP)
 	@mkdir -p $(OUT)
-	$(BIN)/labstand run --backend sim --situation 11 --note "make demo" -o $(OUT)/run-11.mcap
+	$(BIN)/labstand run --backend sim --effect $(DEMO_EFFECT) --situation 11 --note "make demo" -o $(OUT)/run-11.mcap
+	$(BIN)/labstand run --backend sim --effect $(DEMO_EFFECT) --situation 10 --note "make demo" -o $(OUT)/run-10.mcap
 	$(BIN)/labstand replay $(OUT)/run-11.mcap --plot $(OUT)/replay-11.png
+	$(BIN)/labstand diagnose $(OUT)/run-11.mcap $(OUT)/run-10.mcap --report $(OUT)/diagnosis
 
 # Debian tools the tests use as independent peers; installed here, never assumed.
 system-tools:

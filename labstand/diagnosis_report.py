@@ -74,31 +74,62 @@ def _ranking_plot(path: Path, result: Diagnosis) -> None:
     plt.close(fig)
 
 
+#: Width of the zoomed window around the largest residual, s.
+ZOOM_S = 0.4
+
+
 def _overlay_plot(path: Path, traces: Sequence[Trace], result: Diagnosis) -> None:
+    """Per trace and channel: the residuals over the whole trace, and a zoomed overlay.
+
+    Recorded, baseline and augmented lie within a fraction of a line width of each other
+    at full scale; the residuals (model − recorded) and a window around the baseline's
+    largest residual show the difference a person is looking for.
+    """
     plt = pyplot()
     fig, axes = plt.subplots(
-        2 * len(traces), 1, figsize=(11, 3.2 * len(traces)), squeeze=False, constrained_layout=True
+        2 * len(traces),
+        2,
+        figsize=(12, 3.0 * len(traces)),
+        squeeze=False,
+        constrained_layout=True,
+        gridspec_kw={"width_ratios": [2.2, 1]},
     )
+    named = " + ".join(e.effect for e in result.effects)
     for i, tr in enumerate(traces):
         t = np.arange(tr.samples) / tr.rate_hz
         before, after = result.outputs_before[i], result.outputs_after[i]
-        for j, (name, rec, b, a) in enumerate(
+        for j, (name, unit, scale, rec, b, a) in enumerate(
             (
-                ("u [mm]", tr.u_m * 1e3, before.u_m * 1e3, after.u_m * 1e3),
-                ("F [N]", tr.force_n, before.force_n, after.force_n),
+                ("u", "mm", 1e3, tr.u_m, before.u_m, after.u_m),
+                ("F", "N", 1.0, tr.force_n, before.force_n, after.force_n),
             )
         ):
+            res_b = np.where(tr.present, b - rec, np.nan) * scale
+            res_a = np.where(tr.present, a - rec, np.nan) * scale
             ax = axes[2 * i + j, 0]
-            ax.plot(t, rec, color="k", lw=0.8, label="recorded")
-            ax.plot(t, b, color="tab:blue", lw=0.8, ls="--", label="baseline (fitted)")
-            if result.effect != "none":
-                ax.plot(t, a, color="tab:red", lw=0.8, ls=":", label=f"+ {result.effect}")
-            ax.set_ylabel(name)
-            ax.set_title(tr.name, fontsize=9)
+            ax.plot(t, res_b, color="tab:blue", lw=0.6, label="baseline − recorded")
+            if named:
+                ax.plot(t, res_a, color="tab:red", lw=0.6, label=f"+ {named} − recorded")
+            ax.axhline(0.0, color="k", lw=0.5)
+            ax.set_ylabel(f"{name} residual [{unit}]")
+            ax.set_title(f"{tr.name}: residual of {name}", fontsize=9)
             ax.grid(alpha=0.3)
-            if i == 0 and j == 0:
-                ax.legend(fontsize=8, loc="upper right")
+            ax.legend(fontsize=7, loc="upper right")
+            # The window around the baseline's largest residual, at full scale.
+            k = int(np.nanargmax(np.abs(res_b))) if np.isfinite(res_b).any() else 0
+            half = int(ZOOM_S / 2 * tr.rate_hz)
+            win = slice(max(0, k - half), min(tr.samples, k + half))
+            zoom = axes[2 * i + j, 1]
+            zoom.plot(t[win], rec[win] * scale, color="k", lw=1.0, label="recorded")
+            zoom.plot(t[win], b[win] * scale, color="tab:blue", lw=0.9, ls="--", label="baseline")
+            if named:
+                zoom.plot(t[win], a[win] * scale, color="tab:red", lw=0.9, ls=":", label=named)
+            zoom.set_ylabel(f"{name} [{unit}]")
+            zoom.set_title(f"where the baseline misses most (t = {t[k]:.2f} s)", fontsize=9)
+            zoom.grid(alpha=0.3)
+            zoom.legend(fontsize=7, loc="best")
     axes[-1, 0].set_xlabel("time [s]")
+    axes[-1, 1].set_xlabel("time [s]")
     fig.savefig(path, dpi=90)
     plt.close(fig)
 
@@ -157,7 +188,9 @@ bootstrap confidence {result.confidence:.2f}).</p>
 <h3>by regime</h3>{_table(where.regime)}
 <h3>by frequency band</h3>{_table(where.band)}
 <img src="residual.png" alt="residual over time coloured by phase">
-<h2>Recorded, baseline and augmented model</h2><img src="overlay.png" alt="overlay">
+<h2>Recorded, baseline and augmented model</h2>
+<p>Left: the residuals over each recording; right: where the baseline misses most.</p>
+<img src="overlay.png" alt="residuals and a zoomed overlay">
 <h2>Fitted baseline</h2>{_table(result.baseline)}
 </body></html>
 """
