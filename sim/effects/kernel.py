@@ -46,7 +46,8 @@ from numba import njit, prange
 (R_DG_ON, R_DG_GAIN, R_DG_OFFSET) = range(38, 41)
 (R_CS_ON, R_CS_FORCE, R_CS_DISP) = range(41, 44)
 (R_FG_ON, R_FG_FC, R_FG_ZETA) = range(44, 47)
-N_ROW = 47
+R_PJ_ONSET = 47  # appended (the pulley jump's third parameter came last)
+N_ROW = 48
 # Derived constants, then the discrete state, then the friction table: indices into c.
 (D_NSEG, D_T0, D_K1, D_C1, D_K2, D_C2, D_D10, D_D20, D_MP, D_FB0, D_FBL, D_SIGP, D_KB1,
  D_KB2, D_RELAX, D_W1, D_W2, D_F1, D_F2, D_CM1, D_CM2, D_AR1SQ, D_AR2SQ, D_ST1, D_ST2,
@@ -378,11 +379,10 @@ def _after_part(c, y, x, xd):  # type: ignore[no-untyped-def]
                 c[S_DEPTH] = slack
                 base, step = c[S_LBASE], c[R_PJ_STEP]
                 target = step if abs(base) <= abs(base - step) else 0.0  # the other seat
-                change = (target - base) * (1.0 - math.exp(-slack / c[R_PJ_DEPTH]))
-                # The seat moves no further than the slack lets it (exact no-op while
-                # |step| ≤ depth scale, since 1 − e^(−a) ≤ a).
-                change = max(-slack, min(slack, change))
-                c[S_LOFF] = base + change
+                # The fibre leaves its groove once the slack is ``onset`` deep, and has
+                # moved over within a few depth scales more.
+                beyond = max(0.0, slack - c[R_PJ_ONSET])
+                c[S_LOFF] = base + (target - base) * (1.0 - math.exp(-beyond / c[R_PJ_DEPTH]))
         elif c[S_DEPTH] > 0.0:  # the episode is over: the fibre stays in its new seat
             c[S_LBASE] = c[S_LOFF]
             c[S_DEPTH] = 0.0

@@ -191,7 +191,7 @@ _INFOS = (
                bounds=(5.0e2, 2.0e5),
                why="a polymer-matrix fibre's dynamic stiffness exceeds its static one by a "
                    "few per cent up to several times (k is 34–94 kN/m)"),
-            _p("relaxation_time_s", "s", 0.03, (5.0e-3, 0.1), (5.0e-4, 10.0), ek.R_VE_TAU,
+            _p("relaxation_time_s", "s", 0.03, (5.0e-3, 0.1), (1.0e-4, 10.0), ek.R_VE_TAU,
                "τ = c₂/k₂, the branch's relaxation time", log=True, bounds=(5.0e-4, 1.0),
                why="faster than one 2 kHz sample it is plain damping; slower than the slowest "
                    "cycle (≈ 1–2.5 s) it is extra stiffness that k absorbs"),
@@ -220,21 +220,26 @@ _INFOS = (
     ),
     EffectInfo(
         "fibre_pulley_jump", "physical",
-        "while slack the fibre leaves its groove and re-seats in the other of two seats, "
-        "changing the effective length by step_m·(1 − exp(−slack depth/depth_scale_m))",
+        "once the slack is onset_m deep the fibre leaves its groove and re-seats in the other "
+        "of two seats, changing the effective length by "
+        "step_m·(1 − exp(−(slack depth − onset_m)/depth_scale_m))",
         "offset steps in force and position right after slack episodes",
         ek.R_PJ_ON,
         (
-            _p("step_m", "m", 2.0e-4, (1.0e-4, 5.0e-4), (-2.0e-3, 2.0e-3), ek.R_PJ_STEP,
+            _p("step_m", "m", 2.0e-4, (1.0e-4, 5.0e-4), (-1.0e-2, 1.0e-2), ek.R_PJ_STEP,
                "length change of the second seat (+: effective fibre shorter)", log=True,
                bounds=(-3.0e-3, 3.0e-3),
                why="re-seating across an 80 mm pulley's groove or onto its flange changes the "
                    "fibre path by up to a few millimetres, either way"),
-            _p("depth_scale_m", "m", 1.0e-3, (5.0e-4, 5.0e-3), (1.0e-5, 0.1), ek.R_PJ_DEPTH,
+            _p("depth_scale_m", "m", 1.0e-3, (5.0e-4, 5.0e-3), (1.0e-6, 0.1), ek.R_PJ_DEPTH,
                "slack depth over which the fibre completes its jump", log=True,
-               bounds=(1.0e-4, 3.0e-2),
-               why="from a loop as deep as the groove (0.1 mm) to one as high as the flange "
-                   "(a few cm)"),
+               bounds=(1.0e-5, 3.0e-2),
+               why="from a snap (a hundredth of a millimetre of further slack) to a slow "
+                   "slide over a loop as high as the flange (a few cm)"),
+            _p("onset_m", "m", 0.0, (0.0, 1.0e-3), (0.0, 0.05), ek.R_PJ_ONSET,
+               "slack depth at which the fibre leaves its groove", bounds=(0.0, 5.0e-3),
+               why="a fibre held in its groove by friction leaves it only once its loop is "
+                   "as deep as the groove or the flange: 0 to a few millimetres"),
         ),
     ),
     EffectInfo(

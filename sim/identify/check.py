@@ -12,6 +12,7 @@ recordings (as DataFrames, like files read back) and the nominal stand.
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import time
 from collections.abc import Callable, Sequence
@@ -27,6 +28,7 @@ from sim.effects.realism import MeasurementNoise, NoiseSpec, draw_real_stand
 from sim.identify.diagnose import diagnose
 from sim.identify.fitting import Candidate, simulate_values
 from sim.identify.heldout import Outputs, heldout_error
+from sim.identify.shooting import dial_slope
 from sim.identify.traces import Trace, make_trace
 from sim.model import Model
 from sim.params import StandParams
@@ -133,12 +135,14 @@ def make_campaign(
         x_rec = np.round((x + rng.normal(0.0, DRIVE_NOISE_M, x.size)) / 1e-7) * 1e-7
         trace = make_trace(name, t, x_rec, u_rec, f_rec, mass_kg)
         traces.append(trace)
-        if open_loop_oracle:
-            # The trace's u counts from its rest value; the model's rest is u = 0 (plus
-            # any dial gauge offset, which the rest value removes).
-            oracle.append(Outputs(run.true_u_m - run.true_u_m[0], run.true_force_n))
-        else:
-            oracle.append(_oracle(trace, nominal, real, effects))
+        # The trace's u counts from its rest value; the model's rest is u = 0 (plus any
+        # dial gauge offset, which the rest value removes).
+        oracle.append(Outputs(run.true_u_m - run.true_u_m[0], run.true_force_n))
+    if not open_loop_oracle:
+        # As ``diagnose`` sees them: the campaign's dial gauge scale on every trace.
+        slope = dial_slope(traces)
+        judged = [dataclasses.replace(tr, dial_slope=slope) for tr in traces]
+        oracle = [_oracle(tr, nominal, real, effects) for tr in judged]
     return traces, oracle, params
 
 

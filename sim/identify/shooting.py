@@ -197,7 +197,8 @@ def dial_slope(traces: Sequence[Trace]) -> float:
     against the drive encoder — a gauge that reads 10 % high shows a = 1.1/n — without
     knowing k (b absorbs it). Samples where the drive moves fast are left out: there a
     channel skewed in time puts v·Δt into u (a 3 ms skew biased G by 1 % on quick
-    motions; below a fifth of the top speed by a few 0.01 %). The model restarts
+    motions; below a fifth of the top speed by a few 0.01 %), and so are samples after
+    the fibre first went slack. The model restarts
     segments from u/G (``sim.model.Restarts``), so a gauge error stays in the u channel
     instead of becoming a wrong elongation, hundreds of newtons, in F. NaN with too few
     such samples or too little drive travel among them.
@@ -212,7 +213,12 @@ def dial_slope(traces: Sequence[Trace]) -> float:
         calm = np.abs(f_rate) < CALM_SHARE * np.max(np.abs(f_rate))
         drive_rate = np.abs(np.gradient(x))
         slow = drive_rate < SLOW_SHARE * np.max(drive_rate)
-        sel = taut & calm & slow & trace.present & np.isfinite(trace.u_m)
+        # Only before the fibre first goes slack: afterwards the weight's position for a
+        # given drive position can depend on what slack did (a fibre re-seated on the
+        # pulley shifted u by 1.4 mm and biased G by 3 % in a validation campaign).
+        first_slack = np.flatnonzero(f_s < SLACK_SHARE * np.median(f_s))
+        before = np.arange(x.size) < (first_slack[0] if first_slack.size else x.size)
+        sel = taut & calm & slow & before & trace.present & np.isfinite(trace.u_m)
         travel = float(np.ptp(x))
         if np.count_nonzero(sel) < 200 or travel <= 0 or np.ptp(x[sel]) < 0.3 * travel:
             continue
