@@ -1,0 +1,83 @@
+"""The diagnosis's decisions: at a bound, two effects at once, none at any noise level."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from drivers.signals import plan_motion
+from sim.config import StandConfig
+from sim.effects import EffectSpec
+from sim.effects.realism import MeasurementNoise, NoiseSpec, draw_real_stand
+from sim.identify import diagnose, make_trace
+from sim.identify.check import DRIVE_NOISE_M, SMALL_CAMPAIGN
+from sim.identify.decide import p_value_of_gains
+from sim.identify.fitting import FreeParam
+from sim.identify.traces import Trace
+from sim.model import Model
+
+MASS = 8.131
+
+
+def _campaign(
+    stand: StandConfig, effects: list[EffectSpec], seed: int, noise: NoiseSpec | None = None
+) -> list[Trace]:
+    """The small campaign's recordings of a drawn stand with these effects."""
+    rng = np.random.default_rng(seed)
+    real = draw_real_stand(stand.stand_params("final", MASS), rng)
+    spec = noise or NoiseSpec()
+    traces = []
+    for name, signal in SMALL_CAMPAIGN:
+        t, x = plan_motion(signal, stand.drive).sample(stand.sample_rate_hz)
+        run = Model(real, effects).run(x, stand.sample_rate_hz)
+        u, f = MeasurementNoise(spec, stand.sample_rate_hz, rng).apply(run.u_m, run.force_n)
+        x_rec = x + rng.normal(0.0, DRIVE_NOISE_M, x.size)
+        traces.append(make_trace(name, t, x_rec, u, f, MASS))
+    return traces
+
+
+def test_a_fit_that_ends_on_a_bound_is_reported_there(stand: StandConfig) -> None:
+    # A dial gauge reading 30 % high: beyond the ±20 % the physics of a mounted gauge
+    # allows. The fit stops at its bound and says so; it is still the answer.
+    traces = _campaign(stand, [EffectSpec("dial_gauge_calibration", {"gain_error": 0.3})], 1)
+    result = diagnose(traces, stand.stand_params("final", MASS), ["dial_gauge_calibration"])
+    assert result.effect == "dial_gauge_calibration"
+    assert result.effects[0].at_bound == ["gain_error"]
+    assert result.effects[0].params["gain_error"] == pytest.approx(0.2, rel=1e-3)
+    inner = FreeParam("x", -0.2, 0.2)
+    assert inner.at_bound(0.2) and inner.at_bound(-0.2) and not inner.at_bound(0.15)
+
+
+def test_two_effects_at_once_are_both_named(stand: StandConfig) -> None:
+    truth = [
+        EffectSpec("fibre_viscoelastic", {"branch_stiffness_n_m": 3e4, "relaxation_time_s": 0.02}),
+        EffectSpec("dial_gauge_calibration", {"gain_error": 0.05}),
+    ]
+    traces = _campaign(stand, truth, 2)
+    candidates = ["fibre_viscoelastic", "dial_gauge_calibration", "channel_time_skew"]
+    result = diagnose(traces, stand.stand_params("final", MASS), candidates)
+    named = [e.effect for e in result.effects]
+    assert sorted(named) == sorted(e.name for e in truth)
+    first, second = result.effects
+    assert first.closure > 0 and second.closure > 0 and first.p_value <= result.alpha
+    assert result.to_dict()["effects"][1]["effect"] == second.effect
+
+
+@pytest.mark.parametrize("scale", [0.3, 1.0, 3.0])
+def test_no_effect_is_answered_none_whatever_the_noise(stand: StandConfig, scale: float) -> None:
+    noise = NoiseSpec(force_rms_n=0.1 * scale, displacement_rms_m=5e-6 * scale)
+    traces = _campaign(stand, [], 3, noise)
+    candidates = ["fibre_viscoelastic", "force_gauge_dynamics", "channel_time_skew"]
+    result = diagnose(traces, stand.stand_params("final", MASS), candidates)
+    assert result.effect == "none", [(r.effect, r.p_value) for r in result.ranking]
+    assert result.effects == []
+
+
+def test_the_evidence_is_a_one_sided_rank_test() -> None:
+    rng = np.random.default_rng(0)
+    # Gains that straddle zero are no evidence; consistently positive ones are, whatever
+    # their sizes (a rank test: one huge block does not make the case alone).
+    assert p_value_of_gains(rng.normal(0.0, 1.0, 12)) > 0.05
+    assert p_value_of_gains(np.abs(rng.normal(0.0, 1.0, 12))) < 1e-3
+    assert p_value_of_gains(np.array([100.0, -1, 1, -1, 1, -1, 1, -1])) > 0.05
+    assert p_value_of_gains(np.array([1.0])) == 1.0
