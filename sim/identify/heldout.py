@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -104,27 +105,8 @@ def heldout_excess(traces: Sequence[Trace], outputs: Sequence[Outputs]) -> float
 def cycle_improvements(
     traces: Sequence[Trace], before: Sequence[Outputs], after: Sequence[Outputs]
 ) -> FloatArray:
-    """Per held-out cycle: drop in squared error in noise units (positive = better after)."""
-    gains = []
-    for tr, b, a in zip(traces, before, after, strict=True):
-        idx = tr.test
-        count = int(idx.sum()) or 1
-        scales = [
-            _noise_scale(tr.u_m[idx], tr.noise_u_m),
-            _noise_scale(tr.force_n[idx], tr.noise_force_n),
-        ]
-        for c in np.unique(tr.cycle[idx]):
-            sel = idx & (tr.cycle == c)
-            total = 0.0
-            for rec, sb, sa, scale in (
-                (tr.u_m, b.u_m, a.u_m, scales[0]),
-                (tr.force_n, b.force_n, a.force_n, scales[1]),
-            ):
-                eb = np.sum((sb[sel] - rec[sel]) ** 2)
-                ea = np.sum((sa[sel] - rec[sel]) ** 2)
-                total += float(eb - ea) / (scale**2 * count)
-            gains.append(total)
-    return np.asarray(gains)
+    """Per held-out cycle: drop in mean squared error in noise units (positive = better)."""
+    return block_improvements(traces, before, after, block_s=math.inf)
 
 
 def block_improvements(
@@ -147,10 +129,9 @@ def block_improvements(
             _noise_scale(tr.u_m[idx], tr.noise_u_m),
             _noise_scale(tr.force_n[idx], tr.noise_force_n),
         ]
-        per_block = max(1, round(block_s * tr.rate_hz))
         for c in np.unique(tr.cycle[idx]):
             samples = np.flatnonzero(idx & (tr.cycle == c))
-            pieces = max(1, samples.size // per_block)
+            pieces = max(1, int(samples.size // (block_s * tr.rate_hz)))
             for sel in np.array_split(samples, pieces):
                 total = 0.0
                 for rec, sb, sa, scale in (
