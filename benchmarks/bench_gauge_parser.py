@@ -79,8 +79,8 @@ def bench(parser: FrameParser | NaiveParser, data: bytes, chunk: int) -> tuple[f
 def live(seconds: float, modbus: str) -> None:
     from drivers.gauge_stream import SerialGaugeStream
     from drivers.unidrive import open_unidrive
-    from labstand.commands.stand_sim import StandProcess
     from sim.config import default_config
+    from sim.hardware.process import StandProcess
 
     config = default_config()
     with StandProcess(["--modbus", modbus]) as sim:

@@ -6,15 +6,9 @@ An acquisition session depends on two small interfaces (``drivers.interfaces``):
 ``SerialGaugeStream``, built with ``open_gauges(path, calibration)``). Which port or
 address they use is configuration; the simulated stand serves the same protocols.
 
-Exceptions::
-
-    Exception
-     ├── ValueError
-     │    └── LimitError        a command beyond the drive's limits (nothing moved)
-     ├── DriveError             drivers.unidrive (tree in its docstring)
-     └── GaugeError             drivers.gauge_stream (tree in its docstring)
-    RuntimeError
-     └── ClosedError            a driver used after close()
+Exceptions: one root, ``DeviceError`` (``drivers.errors``, tree in its docstring), with
+``DriveError``, ``GaugeError``, ``DeviceTimeoutError`` and ``ClosedError`` under it;
+``LimitError`` (a ValueError) refuses a command before anything moves.
 """
 
 from __future__ import annotations
@@ -26,11 +20,13 @@ from typing import TYPE_CHECKING, Any
 # model, say) must not load pymodbus and pyserial through this package.
 _EXPORTS = {
     "GaugeCalibration": "drivers.calibration",
-    "GaugeError": "drivers.gauge_stream",
+    "DeviceError": "drivers.errors",
+    "DeviceTimeoutError": "drivers.errors",
+    "GaugeError": "drivers.errors",
     "SerialGaugeStream": "drivers.gauge_stream",
     "open_gauges": "drivers.gauge_stream",
     "SAMPLE_DTYPE": "drivers.interfaces",
-    "ClosedError": "drivers.interfaces",
+    "ClosedError": "drivers.errors",
     "DriveInterface": "drivers.interfaces",
     "DriveState": "drivers.interfaces",
     "GaugeSource": "drivers.interfaces",
@@ -41,7 +37,7 @@ _EXPORTS = {
     "Shape": "drivers.signals",
     "SignalSpec": "drivers.signals",
     "plan_motion": "drivers.signals",
-    "DriveError": "drivers.unidrive",
+    "DriveError": "drivers.errors",
     "UnidriveSP": "drivers.unidrive",
     "open_unidrive": "drivers.unidrive",
     "ProfileState": "drivers.unidrive_profile",
@@ -49,10 +45,10 @@ _EXPORTS = {
 
 if TYPE_CHECKING:
     from drivers.calibration import GaugeCalibration
-    from drivers.gauge_stream import GaugeError, SerialGaugeStream, open_gauges
+    from drivers.errors import ClosedError, DeviceError, DeviceTimeoutError, DriveError, GaugeError
+    from drivers.gauge_stream import SerialGaugeStream, open_gauges
     from drivers.interfaces import (
         SAMPLE_DTYPE,
-        ClosedError,
         DriveInterface,
         DriveState,
         GaugeSource,
@@ -60,7 +56,7 @@ if TYPE_CHECKING:
     )
     from drivers.limits import DriveLimits, LimitError
     from drivers.signals import DriveProfile, Shape, SignalSpec, plan_motion
-    from drivers.unidrive import DriveError, UnidriveSP, open_unidrive
+    from drivers.unidrive import UnidriveSP, open_unidrive
     from drivers.unidrive_profile import ProfileState
 
 
@@ -74,6 +70,8 @@ def __getattr__(name: str) -> Any:
 __all__ = [
     "SAMPLE_DTYPE",
     "ClosedError",
+    "DeviceError",
+    "DeviceTimeoutError",
     "DriveError",
     "DriveInterface",
     "DriveLimits",

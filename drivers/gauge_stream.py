@@ -30,6 +30,7 @@ import serial
 from numpy.typing import NDArray
 
 from drivers.calibration import GaugeCalibration
+from drivers.errors import GaugeError
 from drivers.gauge_frame import FrameParser
 from drivers.interfaces import SAMPLE_DTYPE, ClosedError, GaugeSource, GaugeStats
 
@@ -42,10 +43,6 @@ __all__ = [
     "SerialGaugeStream",
     "SerialLike",
 ]
-
-
-class GaugeError(Exception):
-    """Anything the gauge stream raises."""
 
 
 class GaugeConnectionError(GaugeError, ConnectionError):

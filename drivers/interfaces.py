@@ -20,6 +20,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from drivers.closing import ClosesOnExit
+from drivers.errors import ClosedError
 from drivers.limits import DriveLimits
 from drivers.signals import DriveProfile, SignalSpec
 from drivers.unidrive_profile import ProfileState
@@ -50,10 +51,6 @@ SAMPLE_DTYPE = np.dtype(
         ("flags", "u1"),
     ]
 )
-
-
-class ClosedError(RuntimeError):
-    """A driver was used after ``close()``."""
 
 
 @dataclass(frozen=True)

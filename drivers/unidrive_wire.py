@@ -11,6 +11,7 @@ from typing import Protocol
 from pymodbus.client.mixin import ModbusClientMixin
 from pymodbus.pdu import ModbusPDU
 
+from drivers.errors import DeviceTimeoutError, DriveError
 from drivers.interfaces import ClosedError
 from drivers.unidrive_profile import RejectReason
 
@@ -31,15 +32,11 @@ __all__ = [
 ]
 
 
-class DriveError(Exception):
-    """Anything the drive driver raises."""
-
-
 class DriveConnectionError(DriveError, ConnectionError):
     """The drive cannot be reached (port, address, cable)."""
 
 
-class DriveTimeoutError(DriveError, TimeoutError):
+class DriveTimeoutError(DriveError, DeviceTimeoutError):
     """The drive did not answer within the time-out, after every retry."""
 
 

@@ -28,11 +28,10 @@ from typing import TypeVar
 import numpy as np
 from numpy.typing import NDArray
 
-from drivers.gauge_stream import GaugeError
+from drivers.errors import DriveError, GaugeError
 from drivers.interfaces import DriveState, GaugeStats
 from drivers.signals import DriveProfile, SignalSpec
 from drivers.unidrive_profile import ProfileState
-from drivers.unidrive_wire import DriveError
 from labstand.session_loop import SessionLoop
 from labstand.session_record import RecordingPipe
 from labstand.session_safety import EStopError, SafetyMonitor

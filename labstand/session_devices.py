@@ -15,13 +15,14 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from drivers.gauge_stream import GaugeError, open_gauges
+from drivers.errors import DriveError, GaugeError
+from drivers.gauge_stream import open_gauges
 from drivers.interfaces import DriveInterface, GaugeSource
-from drivers.unidrive import DriveError, open_unidrive
-from labstand.commands.stand_sim import StandProcess
+from drivers.unidrive import open_unidrive
 from labstand.errors import CommandError, ExitCode
 from recordings.schema import Backend
 from sim.config import StandConfig
+from sim.hardware.process import StandProcess, StandStartError
 
 log = logging.getLogger(__name__)
 
@@ -125,7 +126,10 @@ def open_devices(
     for text in effects:
         args += ["--effect", text]
     sim = StandProcess([*args, *sim_args])
-    ep = sim.start()
+    try:
+        ep = sim.start()
+    except StandStartError as err:
+        raise CommandError(str(err)) from None
     try:
         devices = _open(ep["modbus"], ep["gauges"], config, Backend.SIM)
     except BaseException:

@@ -20,10 +20,9 @@ from collections.abc import Iterator
 import numpy as np
 from numpy.typing import NDArray
 
-from drivers.gauge_stream import GaugeError
-from drivers.interfaces import ClosedError, DriveInterface, DriveState, GaugeSource, GaugeStats
+from drivers.errors import ClosedError, DriveError, GaugeError
+from drivers.interfaces import DriveInterface, DriveState, GaugeSource, GaugeStats
 from drivers.signals import DriveProfile
-from drivers.unidrive_wire import DriveError
 from labstand.display import Display, RunStatus
 from labstand.session_record import RecordingPipe, RunClock
 from labstand.session_safety import EStopError, SafetyLimits, SafetyMonitor

@@ -6,9 +6,9 @@ with ``--json`` as one line ``{"event": "ready", "modbus": URL, "gauges": PATH, 
 and runs until Ctrl-C or SIGTERM, or until the process named by ``--parent-pid`` is
 gone. On exit it prints ``{"event": "stopped", ...}`` and leaves nothing running.
 
-``StandProcess`` starts the command as a child process (how ``labstand run --backend
-sim`` uses it): it passes its own pid as ``--parent-pid``, so the child exits within a
-fraction of a second even if the parent is killed with SIGKILL.
+``sim.hardware.process.StandProcess`` starts the command as a child process (how
+``labstand run --backend sim`` uses it): it passes its own pid as ``--parent-pid``, so
+the child exits within a fraction of a second even if the parent is killed with SIGKILL.
 """
 
 from __future__ import annotations
@@ -18,17 +18,11 @@ import asyncio
 import contextlib
 import json
 import os
-import select
 import signal
-import subprocess
 import sys
-import time
-from collections.abc import Sequence
-from types import TracebackType
-from typing import Any, Self, TextIO
+from typing import TextIO
 
 from labstand.commands.common import add_stand_options, load_stand
-from labstand.errors import CommandError
 from sim.hardware.faults import parse_fault
 from sim.hardware.gauges import FrontEndSettings
 from sim.hardware.stand import ScaledClock, SimulatedStand, StandSettings
@@ -170,95 +164,3 @@ def run_stand_sim(args: argparse.Namespace) -> int:
         if args.json:
             _say(json.dumps({"event": "stopped", **summary}))
     return 0
-
-
-class StandProcess:
-    """``labstand stand-sim --json`` as a child process.
-
-    ``with StandProcess(["--mass-kg", "3.096"]) as sim: sim.endpoints["modbus"]`` starts
-    it, waits for its ready line and stops it (SIGTERM, then SIGKILL) on exit.
-    """
-
-    def __init__(self, extra_args: Sequence[str] = (), start_timeout_s: float = 30.0) -> None:
-        self.args = [
-            sys.executable,
-            "-m",
-            "labstand",
-            "stand-sim",
-            "--json",
-            "--parent-pid",
-            str(os.getpid()),
-            *extra_args,
-        ]
-        self._timeout = start_timeout_s
-        self.process: subprocess.Popen[str] | None = None
-        self.endpoints: dict[str, Any] = {}
-        self.stopped: dict[str, Any] = {}  # the child's last line, once it has exited
-
-    def start(self) -> dict[str, Any]:
-        """Start the child and return its ready line (endpoints)."""
-        # A session of its own: Ctrl-C at the terminal reaches the parent alone, which
-        # then stops the run in order while the simulated stand keeps serving.
-        self.process = subprocess.Popen(
-            self.args,
-            stdout=subprocess.PIPE,
-            stderr=subprocess.PIPE,
-            text=True,
-            start_new_session=True,
-        )
-        assert self.process.stdout is not None
-        ready, _, _ = select.select([self.process.stdout], [], [], self._timeout)
-        line = self.process.stdout.readline() if ready else ""
-        if not line:
-            self.stop()
-            raise CommandError(f"the simulated stand did not start: {self._stderr()}")
-        self.endpoints = json.loads(line)
-        return self.endpoints
-
-    def _stderr(self) -> str:
-        if self.process is None or self.process.stderr is None or self.process.poll() is None:
-            return "no ready line in time"
-        return self.process.stderr.read().strip()[-2000:]
-
-    def stop(self, timeout_s: float = 5.0) -> int | None:
-        """SIGTERM and wait; SIGKILL if it does not exit in time. Returns the exit code."""
-        p = self.process
-        if p is None:
-            return None
-        if p.poll() is None:
-            p.terminate()
-            try:
-                p.wait(timeout_s)
-            except subprocess.TimeoutExpired:
-                p.kill()
-                p.wait(timeout_s)
-        if p.stdout is not None and not p.stdout.closed:
-            for line in p.stdout.read().splitlines():
-                with contextlib.suppress(ValueError):
-                    self.stopped = json.loads(line)
-        for stream in (p.stdout, p.stderr):
-            if stream is not None:
-                stream.close()
-        return p.returncode
-
-    def __enter__(self) -> Self:
-        self.start()
-        return self
-
-    def __exit__(
-        self,
-        exc_type: type[BaseException] | None,
-        exc: BaseException | None,
-        tb: TracebackType | None,
-    ) -> None:
-        self.stop()
-
-
-def wait_exit(process: subprocess.Popen[Any], timeout_s: float) -> int | None:
-    """The exit code once the process ends within timeout_s, else None."""
-    deadline = time.monotonic() + timeout_s
-    while time.monotonic() < deadline:
-        if (code := process.poll()) is not None:
-            return code
-        time.sleep(0.02)
-    return None

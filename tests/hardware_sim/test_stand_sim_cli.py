@@ -16,8 +16,8 @@ import pytest
 from drivers.gauge_stream import SerialGaugeStream
 from drivers.unidrive import open_unidrive
 from labstand.cli import main
-from labstand.commands.stand_sim import StandProcess, wait_exit
 from sim.config import StandConfig
+from sim.hardware.process import StandProcess, wait_exit
 from tests.hardware_sim.leakcheck import gone
 
 
