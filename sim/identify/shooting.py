@@ -69,6 +69,10 @@ SLACK_SHARE = 0.1
 class Segments:
     """How one trace is cut, and its measured states at the segment starts.
 
+    Half of it is what the model takes as ``sim.model.Restarts`` (``restarts``: starts,
+    lengths, the smoothed channels, the dial slope); the other half how the runs tile the
+    trace (body, seg_of, offset), which only the diagnosis needs.
+
     Attributes
     ----------
     starts, lengths
