@@ -267,7 +267,3 @@ class Model:
                 self.stand, rate_hz, self.effects, x0_m, self.substeps
             )
         return _baseline.BaselineStream(self.stand, rate_hz, x0_m, self.substeps)
-
-    def warm_up(self) -> None:
-        """Compile the kernels this model uses (numba), so a real-time start is not late."""
-        self.stream(2000.0).advance(np.zeros(2))
