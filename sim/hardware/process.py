@@ -29,10 +29,12 @@ class StandProcess:
     """``labstand stand-sim --json`` as a child process.
 
     ``with StandProcess(["--mass-kg", "3.096"]) as sim: sim.endpoints["modbus"]`` starts
-    it, waits for its ready line and stops it (SIGTERM, then SIGKILL) on exit.
+    it, waits for its ready line and stops it (SIGTERM, then SIGKILL) on exit. The first
+    start in a fresh checkout compiles the model's kernels (≈ 10 s, more on a busy
+    machine) before the ready line, hence the generous time-out.
     """
 
-    def __init__(self, extra_args: Sequence[str] = (), start_timeout_s: float = 30.0) -> None:
+    def __init__(self, extra_args: Sequence[str] = (), start_timeout_s: float = 120.0) -> None:
         self.args = [
             sys.executable,
             "-m",

@@ -41,7 +41,6 @@ from sim.hardware.modbus_server import make_device, start_rtu_server, start_tcp_
 from sim.hardware.pty import PtyBridge, RawPty, open_raw_pty
 from sim.hardware.servo import ServoSettings
 from sim.hardware.stand_model import build_stand_model
-from sim.model import Model
 from sim.params import StandParams
 
 log = logging.getLogger(__name__)
@@ -177,8 +176,10 @@ class SimulatedStand:
 
     async def start(self) -> Endpoints:
         """Open the ptys, start the Modbus server; returns where to connect."""
-        # Compile the model's kernel now, not in the first Modbus request's time-out.
-        Model(self._params).stream(self.drive.rate_hz).advance(np.zeros(2))
+        # Compile the model's kernels now (the augmented one too, with effects), not in
+        # the first Modbus request's time-out: a throwaway copy of the stand's model.
+        rate = self.drive.rate_hz
+        build_stand_model(self._params, rate, self.settings.effects).advance(np.zeros(2))
         try:
             self._gauge_pty = open_raw_pty()
             self.writer = PtyWriter(self._gauge_pty.master_fd)
