@@ -8,7 +8,17 @@ import sys
 from pathlib import Path
 
 from labstand.commands.common import add_stand_options, load_stand
-from sim.identify.check import CLASSES, FULL_CAMPAIGN, MASSES_KG, SMALL_CAMPAIGN, run_check
+from labstand.errors import CommandError, ExitCode
+from sim.identify.check import (
+    CLASSES,
+    FULL_CAMPAIGN,
+    MASSES_KG,
+    SMALL_CAMPAIGN,
+    TRUTHS,
+    run_check,
+)
+from sim.otherstand import OTHER_EFFECTS, OTHER_PAIRS
+from sim.otherstand.campaign import OTHER_FULL, OTHER_SMALL
 
 
 def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -24,12 +34,28 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     parser.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     parser.add_argument("--trials", type=int, default=1, help="campaigns per class and mass (1)")
     parser.add_argument(
+        "--truth",
+        choices=TRUTHS,
+        default="same",
+        help="where the truth comes from: 'same' (the candidate models' own code, default) "
+        "or 'other' (an independently written stand with a second form of every effect, "
+        "other drive signals and the validation set's noise)",
+    )
+    parser.add_argument(
+        "--pairs",
+        nargs="*",
+        metavar="A+B",
+        help="with --truth other: also campaigns with two effects at once (no value: the "
+        "standard pairs; else the given ones, e.g. stick_slip_friction+channel_time_skew)",
+    )
+    parser.add_argument(
         "--effects",
-        nargs="+",
+        nargs="*",
         choices=CLASSES,
         default=CLASSES,
         metavar="NAME",
-        help="classes to check (default: all nine effects and none)",
+        help="classes to check (default: all nine effects and none; none given: no "
+        "single-effect campaigns, only --pairs)",
     )
     parser.add_argument(
         "--mass-kg",
@@ -48,9 +74,31 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     parser.set_defaults(func=run)
 
 
+def _pairs(args: argparse.Namespace) -> list[tuple[str, str]]:
+    """The two-effect campaigns asked for (CommandError, exit 2, if malformed)."""
+    if args.pairs is None:
+        return []
+    if args.truth != "other":
+        raise CommandError("--pairs needs --truth other", ExitCode.USAGE)
+    if not args.pairs:
+        return list(OTHER_PAIRS)
+    pairs = []
+    for text in args.pairs:
+        names = text.split("+")
+        if len(names) != 2 or names[0] == names[1] or not set(names) <= set(OTHER_EFFECTS):
+            raise CommandError(
+                f"--pairs: {text!r} is not two different effects joined by '+' "
+                f"(known: {', '.join(OTHER_EFFECTS)})",
+                ExitCode.USAGE,
+            )
+        pairs.append((names[0], names[1]))
+    return pairs
+
+
 def run(args: argparse.Namespace) -> int:
     """Run the check and report."""
     stand = load_stand(args)
+    pairs = _pairs(args)
 
     def progress(message: str) -> None:
         print(f"labstand diagnose-check: {message}", file=sys.stderr, flush=True)
@@ -58,17 +106,20 @@ def run(args: argparse.Namespace) -> int:
     result = run_check(
         stand, seed=args.seed, trials=args.trials, classes=args.effects, masses=args.mass_kg,
         campaign=SMALL_CAMPAIGN if args.small else FULL_CAMPAIGN, progress=progress,
+        truth_stand=args.truth, other_campaign=OTHER_SMALL if args.small else OTHER_FULL,
+        pairs=pairs,
     )  # fmt: skip
     out = result.to_dict()
     out["seed"] = args.seed
+    out["truth"] = args.truth
     if args.output is not None:
         args.output.write_text(json.dumps(out, indent=2))
     if args.json:
         print(json.dumps(out, indent=2))
         return 0
     print(
-        f"{out['cases']} blind campaigns (seed {args.seed}): top-1 accuracy {out['accuracy']:.2f}, "
-        f"false alarms on none {out['false_alarm_rate']:.2f}"
+        f"{out['cases']} blind campaigns (seed {args.seed}, truth {args.truth}): top-1 accuracy "
+        f"{out['accuracy']:.2f}, false alarms on none {out['false_alarm_rate']:.2f}"
     )
     print(
         f"median NRMSE shrink (correct answers) {out['median_shrink']:.2f}, "
@@ -81,4 +132,11 @@ def run(args: argparse.Namespace) -> int:
     for truth in labels:
         row = out["confusion"][truth]
         print(f"  {truth:26s}" + " ".join(f"{row[a]:6d}" for a in labels))
+    if "pairs" in out:
+        p = out["pairs"]
+        both = f"{p['both_named']:.2f}" if p["effects_reported"] else "n/a (no effects list yet)"
+        print(
+            f"{p['cases']} two-effect campaigns: both named {both}, "
+            f"strongest answer one of the pair {p['one_named']:.2f}"
+        )
     return 0

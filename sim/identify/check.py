@@ -8,6 +8,11 @@ a random magnitude within its plausible range, realistic gauge noise, hum and
 quantisation, and noise on the drive encoder too. Three recordings — a quick, a medium
 and a slow drive motion — are simulated with that truth. The diagnosis sees only the
 recordings (as DataFrames, like files read back) and the nominal stand.
+
+``truth_stand``: ``"same"`` draws the truth from the candidate models themselves (as
+above); ``"other"`` from ``sim.otherstand``, an independently written stand with a second
+formulation of every effect, its own ranges, four other drive signals and the validation
+set's noise levels. ``pairs`` (other truth only) adds campaigns with two effects at once.
 """
 
 from __future__ import annotations
@@ -25,17 +30,21 @@ from drivers.signals import Shape, SignalSpec, plan_motion
 from sim.config import StandConfig
 from sim.effects import EFFECTS, EffectSpec
 from sim.effects.realism import MeasurementNoise, NoiseSpec, draw_real_stand
+from sim.identify.check_other import PairCase, named_effects, other_campaign_traces, pairs_summary
 from sim.identify.diagnose import diagnose
 from sim.identify.fitting import Candidate, simulate_values
 from sim.identify.heldout import Outputs, heldout_error
 from sim.identify.shooting import dial_slope
 from sim.identify.traces import Trace, make_trace
 from sim.model import Model
+from sim.otherstand.campaign import OTHER_FULL, OtherRecording
 from sim.params import StandParams
 
 log = logging.getLogger(__name__)
 
 CLASSES = ["none", *EFFECTS]
+#: Where a check's truth comes from: the candidates' own code, or the other stand.
+TRUTHS = ("same", "other")
 MASSES_KG = (3.096, 8.131)
 #: Drive encoder noise on x, m rms (the model is driven by the *measured* x).
 DRIVE_NOISE_M = 1e-6
@@ -74,6 +83,7 @@ class CheckResult:
     """Scores of a check run (see to_dict for the JSON keys)."""
 
     cases: list[Case] = field(default_factory=list)
+    pair_cases: list[PairCase] = field(default_factory=list)
 
     def to_dict(self) -> dict[str, Any]:
         """accuracy, false_alarm_rate, confusion, median_shrink, oracle_median_shrink, ..."""
@@ -100,6 +110,7 @@ class CheckResult:
             ),
             "median_seconds": float(np.median([c.seconds for c in self.cases])) if n else 0.0,
             "details": [c.__dict__ for c in self.cases],
+            **({"pairs": pairs_summary(self.pair_cases)} if self.pair_cases else {}),
         }
 
 
@@ -110,13 +121,24 @@ def make_campaign(
     rng: np.random.Generator,
     campaign: Sequence[tuple[str, SignalSpec]] = FULL_CAMPAIGN,
     open_loop_oracle: bool = False,
+    truth_stand: str = "same",
+    other_campaign: Sequence[OtherRecording] = OTHER_FULL,
 ) -> tuple[list[Trace], list[Outputs], dict[str, float]]:
     """Recordings of a drawn "real" stand with the effect ``truth`` (or none).
 
     Returns the traces (what the diagnosis sees), the true model's outputs (the oracle:
     judged by multiple shooting like every candidate, or with ``open_loop_oracle`` the
-    true noise-free channels), and the true effect parameters.
+    true noise-free channels), and the true effect parameters. With
+    ``truth_stand="other"`` the recordings are ``other_campaign`` on the other stand,
+    ``truth`` may name two effects joined by ``+``, the parameters are keyed
+    ``effect.param``, and the oracle is the other stand's noise-free channels (its
+    equations are not the candidates', so no candidate can be judged as the truth).
     """
+    if truth_stand == "other":
+        names = [] if truth == "none" else truth.split("+")
+        return other_campaign_traces(stand, names, mass_kg, rng, other_campaign)
+    if truth_stand != "same":
+        raise ValueError(f"truth_stand must be one of {', '.join(TRUTHS)}, got {truth_stand!r}")
     nominal = stand.stand_params("final", mass_kg)
     real = draw_real_stand(nominal, rng)
     effects: list[EffectSpec] = []
@@ -177,18 +199,30 @@ def run_check(
     masses: Sequence[float] = MASSES_KG,
     campaign: Sequence[tuple[str, SignalSpec]] = FULL_CAMPAIGN,
     progress: Callable[[str], None] | None = None,
+    truth_stand: str = "same",
+    other_campaign: Sequence[OtherRecording] = OTHER_FULL,
+    pairs: Sequence[tuple[str, str]] = (),
 ) -> CheckResult:
-    """Diagnose trials × classes × masses blind campaigns and score them."""
+    """Diagnose trials × classes × masses blind campaigns and score them.
+
+    ``truth_stand`` and ``other_campaign``: see ``make_campaign``. ``pairs`` (other truth
+    only): two-effect campaigns, each at every mass, scored apart (``CheckResult.pair_cases``).
+    """
+    if pairs and truth_stand != "other":
+        raise ValueError("two-effect campaigns need the other truth stand")
     say = progress or (lambda _m: None)
     rng = np.random.default_rng(seed)
     result = CheckResult()
-    total = trials * len(classes) * len(masses)
+    total = trials * (len(classes) + len(pairs)) * len(masses)
     k = 0
     for _ in range(trials):
         for mass in masses:
             for truth in classes:
                 k += 1
-                traces, oracle, params = make_campaign(stand, truth, mass, rng, campaign)
+                traces, oracle, params = make_campaign(
+                    stand, truth, mass, rng, campaign,
+                    truth_stand=truth_stand, other_campaign=other_campaign,
+                )  # fmt: skip
                 started = time.perf_counter()
                 d = diagnose(traces, stand.stand_params("final", mass))
                 seconds = time.perf_counter() - started
@@ -203,5 +237,21 @@ def run_check(
                 say(
                     f"[{k}/{total}] m={mass:g} kg truth {truth}: answer {d.effect} ({mark}, "
                     f"{seconds:.0f} s)"
+                )
+            for pair in pairs:
+                k += 1
+                traces, _, params = make_campaign(
+                    stand, "+".join(pair), mass, rng, campaign,
+                    truth_stand=truth_stand, other_campaign=other_campaign,
+                )  # fmt: skip
+                started = time.perf_counter()
+                d = diagnose(traces, stand.stand_params("final", mass))
+                seconds = time.perf_counter() - started
+                case = PairCase(pair, mass, d.effect, named_effects(d), params, seconds)
+                result.pair_cases.append(case)
+                mark = "both" if case.both_named else "one" if case.one_named else "WRONG"
+                say(
+                    f"[{k}/{total}] m={mass:g} kg truth {'+'.join(pair)}: answer {d.effect} "
+                    f"(effects {case.answers}; {mark}, {seconds:.0f} s)"
                 )
     return result
