@@ -80,7 +80,11 @@ def _error_code(err: Exception) -> ExitCode:
 
 
 def _subparser(parser: argparse.ArgumentParser, name: str | None) -> argparse.ArgumentParser | None:
-    """The sub-command's parser (for its usage errors), or None."""
+    """The sub-command's parser (for its usage errors), or None.
+
+    argparse has no public way to reach its sub-parsers; its private ``_subparsers`` group
+    has been stable since Python 3.2.
+    """
     for action in parser._subparsers._group_actions if parser._subparsers else ():
         if isinstance(action, argparse._SubParsersAction) and name in action.choices:
             found: argparse.ArgumentParser = action.choices[name]
