@@ -298,7 +298,8 @@ def _second_effect(
     best: tuple[str, _Fitted, Evidence] | None = None
     for effect in tries:
         say(f"refitting {effect} on top of {first}")
-        probe = [{**current.result.values, **probes[effect]}] if effect in probes else []
+        own = {k: v for k, v in probes.get(effect, {}).items() if k.startswith(f"{effect}.")}
+        probe = [{**current.result.values, **own}] if own else []
         fitted = _refit(
             Candidate.build(first, effect), traces, nominal, current.result.values, probe
         )
