@@ -59,7 +59,8 @@ Variant = Mapping[str, float]
 
 _STAND_FIELDS = frozenset(f.name for f in fields(StandParams))
 #: Effects whose own states the gauges cannot see at a restart: carried between segments.
-_CARRIED = ("fibre_transverse_vibration", "stick_slip_friction", "fibre_pulley_jump")
+#: (The pulley seat is not among them: it follows the recorded slack episodes.)
+_CARRIED = ("fibre_transverse_vibration", "stick_slip_friction")
 
 
 class ModelStream(Protocol):

@@ -7,8 +7,9 @@ gain error never becomes a wrong elongation (a wrong force) — it stays in the 
 where a candidate's dial gauge model maps the true u to the reading. A displacement
 channel recorded Δt late shows the true u of Δt earlier, so the true u now is
 u_rec(t + Δt) ≈ u_rec + Δt·v. The Maxwell branch's
-state is its response to the measured elongation history. The other effects' states are
-set inside the kernel (``kernel.measured_state``) or carried between segments.
+state is its response to the measured elongation history; the pulley seat follows the
+recorded slack episodes (``kernel.measured_seats``). The other effects' states are set
+inside the kernel (``kernel.measured_state``) or carried between segments.
 """
 
 from __future__ import annotations
@@ -41,22 +42,34 @@ def start_states(
     ``dial_slope``: du_rec/dx at constant force (NaN: take the gauge's scale as 1).
     """
     rows2 = np.atleast_2d(rows)
-    u = np.broadcast_to(u_m[starts], (rows2.shape[0], starts.size)).copy()
-    v = np.broadcast_to(v_m_s[starts], u.shape).copy()
-    skew = np.where(rows2[:, ek.R_CS_ON] > 0, rows2[:, ek.R_CS_DISP], 0.0)[:, None]
-    u = u + skew * v
-    if np.isfinite(dial_slope) and dial_slope > 0:
-        scale = (dial_slope * rows2[:, ek.P_PROJ])[:, None]
-        u = u / scale
-        v = v / scale
     init = np.zeros((rows2.shape[0], starts.size, ek.N_INIT))
-    init[:, :, ek.I_U] = u
-    init[:, :, ek.I_V] = v
-    init[:, :, ek.I_F] = force_n[starts]
     for b, row in enumerate(rows2):
+        u, v = _true_u(row, u_m, v_m_s, dial_slope)
+        init[b, :, ek.I_U] = u[starts]
+        init[b, :, ek.I_V] = v[starts]
+        init[b, :, ek.I_F] = force_n[starts]
         if row[ek.R_VE_ON] > 0:
             init[b, :, ek.I_HP] = _branch_elongation(row, x_rel_m, rate_hz, u_m)[starts]
+        if row[ek.R_PJ_ON] > 0:
+            # Slack: the force below 5 % of the rest tension, well above the gauge's noise
+            # and hum (tenths of a newton) and far below a taut fibre's force.
+            slack_n = 0.05 * row[ek.P_GRAVITY_N] / row[ek.P_PROJ]
+            init[b, :, ek.I_LOFF : ek.I_SLACKT + 1] = ek.measured_seats(
+                row, x_rel_m, u, force_n, 1.0 / rate_hz, slack_n, starts
+            )
     return init
+
+
+def _true_u(
+    row: FloatArray, u_m: FloatArray, v_m_s: FloatArray, dial_slope: float
+) -> tuple[FloatArray, FloatArray]:
+    """The weight's u and v on the model's scale from the recorded (smoothed) channel."""
+    u = u_m + (row[ek.R_CS_DISP] if row[ek.R_CS_ON] > 0 else 0.0) * v_m_s
+    v = v_m_s
+    if np.isfinite(dial_slope) and dial_slope > 0:
+        scale = dial_slope * row[ek.P_PROJ]
+        u, v = u / scale, v / scale
+    return u, v
 
 
 def _branch_elongation(

@@ -46,15 +46,17 @@ from numba import njit, prange
 (R_DG_ON, R_DG_GAIN, R_DG_OFFSET) = range(38, 41)
 (R_CS_ON, R_CS_FORCE, R_CS_DISP) = range(41, 44)
 (R_FG_ON, R_FG_FC, R_FG_ZETA) = range(44, 47)
-R_PJ_ONSET = 47  # appended (the pulley jump's third parameter came last)
-N_ROW = 48
+R_PJ_ONSET = 47  # appended (the pulley jump's third and fourth parameters came last)
+R_PJ_DWELL = 48
+N_ROW = 49
 # Derived constants, then the discrete state, then the friction table: indices into c.
 (D_NSEG, D_T0, D_K1, D_C1, D_K2, D_C2, D_D10, D_D20, D_MP, D_FB0, D_FBL, D_SIGP, D_KB1,
  D_KB2, D_RELAX, D_W1, D_W2, D_F1, D_F2, D_CM1, D_CM2, D_AR1SQ, D_AR2SQ, D_ST1, D_ST2,
  D_AR1, D_AR2, D_SS_ON, D_SIG0, D_SIG1, D_SL, D_OSC, D_REAL, D_DYN, D_ZONES,
  ) = range(N_ROW, N_ROW + 35)  # fmt: skip
-(S_TAUT1, S_TAUT2, S_ZONE, S_LOFF, S_LBASE, S_DEPTH, S_PZ, S_PS0) = range(N_ROW + 35, N_ROW + 43)
-C_TABLE = N_ROW + 43  # c[C_TABLE] = knots n, then the n knots, then coef (4, n − 1) by rows
+(S_TAUT1, S_TAUT2, S_ZONE, S_LOFF, S_LBASE, S_DEPTH, S_PZ, S_PS0, S_SLACKT,
+ ) = range(N_ROW + 35, N_ROW + 44)  # fmt: skip
+C_TABLE = N_ROW + 44  # c[C_TABLE] = knots n, then the n knots, then coef (4, n − 1) by rows
 
 (Y_U, Y_V, Y_S, Y_SD, Y_Q1, Y_Q2, Y_A1, Y_AD1, Y_A2, Y_AD2, Y_Z) = range(11)
 NY = 11
@@ -365,27 +367,40 @@ def _set_taut(c, y, x, xd):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True, error_model="numpy")
-def _after_part(c, y, x, xd):  # type: ignore[no-untyped-def]
-    """Update the discrete states at the end of an integrated part of a step."""
+def _after_part(c, y, x, xd, h):  # type: ignore[no-untyped-def]
+    """Update the discrete states at the end of an integrated part (h seconds) of a step."""
     if c[D_NSEG] > 1.5 and c[D_SIGP] > 0.0:  # bearing presliding (elasto-plastic)
         t1, t2 = _tensions(c, _segments(c, y, x, 0.0, xd))
         zmax = _bearing_limit(c, t1, t2)
         c[S_PZ] = min(max(c[S_PZ] + y[Y_S] - c[S_PS0], -zmax), zmax)
         c[S_PS0] = y[Y_S]
-    if c[R_PJ_ON] > 0.0:  # re-seating during a geometric slack episode
-        slack = -(c[P_PRELOAD] + x - c[P_PROJ] * y[Y_U] + c[S_LBASE])
-        if slack > 0.0:
-            if slack > c[S_DEPTH]:
-                c[S_DEPTH] = slack
-                base, step = c[S_LBASE], c[R_PJ_STEP]
-                target = step if abs(base) <= abs(base - step) else 0.0  # the other seat
-                # The fibre leaves its groove once the slack is ``onset`` deep, and has
-                # moved over within a few depth scales more.
-                beyond = max(0.0, slack - c[R_PJ_ONSET])
-                c[S_LOFF] = base + (target - base) * (1.0 - math.exp(-beyond / c[R_PJ_DEPTH]))
-        elif c[S_DEPTH] > 0.0:  # the episode is over: the fibre stays in its new seat
-            c[S_LBASE] = c[S_LOFF]
-            c[S_DEPTH] = 0.0
+    if c[R_PJ_ON] > 0.0:
+        _reseat(c, c[S_TAUT2] <= 0.0, c[P_PRELOAD] + x - c[P_PROJ] * y[Y_U], h)
+
+
+@njit(cache=True, error_model="numpy")
+def _reseat(c, slack, elongation, h):  # type: ignore[no-untyped-def]
+    """The pulley seat after h seconds more of a slack (or taut) fibre.
+
+    The fibre leaves its groove once its loop is ``onset`` deep and has lain slack for
+    ``dwell`` (held by groove friction, it needs time to slide out), and has moved over to
+    the other seat within a few depth scales more. The seat follows the episode's deepest
+    geometric slack, so it never moves back within one episode; when the fibre is taut
+    again it stays where it is. The same law runs on the model's slack (``_after_part``)
+    and on the recorded one (``measured_seats``).
+    """
+    if slack:
+        c[S_SLACKT] += h
+        c[S_DEPTH] = max(c[S_DEPTH], -(elongation + c[S_LBASE]))
+        if c[S_SLACKT] >= c[R_PJ_DWELL]:
+            base, step = c[S_LBASE], c[R_PJ_STEP]
+            target = step if abs(base) <= abs(base - step) else 0.0  # the other seat
+            beyond = max(0.0, c[S_DEPTH] - c[R_PJ_ONSET])
+            c[S_LOFF] = base + (target - base) * (1.0 - math.exp(-beyond / c[R_PJ_DEPTH]))
+    elif c[S_SLACKT] > 0.0:  # the episode is over: the fibre stays in its new seat
+        c[S_LBASE] = c[S_LOFF]
+        c[S_DEPTH] = 0.0
+        c[S_SLACKT] = 0.0
 
 
 @njit(cache=True, error_model="numpy")
@@ -418,7 +433,7 @@ def _step(c, y, x0, xd, h):  # type: ignore[no-untyped-def]
                 if th < theta:
                     theta, first = th, j
         if first < 0 and zone_end == zone:
-            _after_part(c, yn, x_end, xd)
+            _after_part(c, yn, x_end, xd, remaining)
             return yn
         if zone_end != zone:
             if not have_f1:
@@ -431,7 +446,7 @@ def _step(c, y, x0, xd, h):  # type: ignore[no-untyped-def]
         part = theta * remaining
         y, _ = _rk4(c, y, xs, xd, part)
         xs = xs + xd * part
-        _after_part(c, y, xs, xd)
+        _after_part(c, y, xs, xd, part)
         remaining = remaining - part
         if first >= 0:
             c[S_TAUT1 + first] = 0.0 if c[S_TAUT1 + first] > 0.0 else 1.0
@@ -443,7 +458,7 @@ def _step(c, y, x0, xd, h):  # type: ignore[no-untyped-def]
     x_end = xs + xd * remaining
     _set_taut(c, y, x_end, xd)
     c[S_ZONE] = _zone(y[Y_V], c)
-    _after_part(c, y, x_end, xd)
+    _after_part(c, y, x_end, xd, remaining)
     return y
 
 
@@ -534,8 +549,32 @@ def simulate_batch_into(x, dt, substeps, rows, knots, coef, out_u, out_v, out_t1
 
 
 # Measured start state of a segment (``simulate_segments_into``): columns of init[b, s].
-(I_U, I_V, I_F, I_HP) = range(4)
-N_INIT = 4
+(I_U, I_V, I_F, I_HP, I_LOFF, I_LBASE, I_DEPTH, I_SLACKT) = range(8)
+N_INIT = 8
+
+
+@njit(cache=True, error_model="numpy")
+def measured_seats(row, x, u, force, dt, slack_n, starts):  # type: ignore[no-untyped-def]
+    """The pulley seat (I_LOFF … I_SLACKT) at each start, from the recorded episodes.
+
+    ``_reseat``'s law driven by the recorded slack (force below ``slack_n``) and the
+    recorded geometry (x relative to rest, u on the model's scale), from the seat at
+    rest. Which groove the fibre sits in is not observable at a restart, but every slack
+    episode that moved it is in the recording; a simulated seat, carried from segment to
+    segment, follows the *model's* slack episodes instead, and one episode too short
+    or too long in a chaotic bounce puts every later seat in the wrong groove.
+    """
+    c = np.zeros(C_TABLE)
+    for i in range(N_ROW):
+        c[i] = row[i]
+    out = np.zeros((starts.shape[0], 4))
+    k = 0
+    for j in range(starts.shape[0]):
+        while k < starts[j]:
+            _reseat(c, force[k] < slack_n, c[P_PRELOAD] + x[k] - c[P_PROJ] * u[k], dt)
+            k += 1
+        out[j, 0], out[j, 1], out[j, 2], out[j, 3] = c[S_LOFF], c[S_LBASE], c[S_DEPTH], c[S_SLACKT]
+    return out
 
 
 @njit(cache=True, error_model="numpy")
@@ -551,10 +590,10 @@ def measured_state(c, x, xd, m):  # type: ignore[no-untyped-def]
     for the measured tension (rest sag while slack; ``simulate_chained_into`` replaces
     them by the previous segment's); LuGre bristle holding the measured
     force balance n·F − m·g·sin α, limited to (and, faster than v_s, at) its sliding
-    value; pulley-jump seat at its base (``simulate_chained_into`` carries the real one:
-    a seat estimated from the measured elongation, rounded to one of the two grooves,
-    picked the wrong groove often enough to cost 340× the open-loop error on a clean
-    recording).
+    value; pulley-jump seat from the recorded slack episodes (``measured_seats``, in
+    m's I_LOFF … I_SLACKT; a seat estimated from the measured elongation at the start,
+    rounded to one of the two grooves, picked the wrong groove often enough to cost 340×
+    the open-loop error on a clean recording).
     Sets the discrete state in c; returns the continuous state tuple.
     """
     u, v, force = m[I_U], m[I_V], m[I_F]
@@ -583,8 +622,7 @@ def measured_state(c, x, xd, m):  # type: ignore[no-untyped-def]
             z = min(max((n * max(force, 0.0) - c[P_GRAVITY_N]) / c[D_SIG0], -limit), limit)
     q1, q2 = c[D_KB1] * m[I_HP], c[D_KB2] * m[I_HP]
     y = (u, v, s, sd, q1, q2, a1, 0.0, a2, 0.0, z)
-    c[S_DEPTH] = 0.0
-    c[S_LOFF], c[S_LBASE] = 0.0, 0.0
+    c[S_LOFF], c[S_LBASE], c[S_DEPTH], c[S_SLACKT] = m[I_LOFF], m[I_LBASE], m[I_DEPTH], m[I_SLACKT]
     c[S_PZ], c[S_PS0] = 0.0, s
     if c[D_NSEG] > 1.5 and c[D_SIGP] > 0.0:
         _set_taut(c, y, x, xd)
@@ -598,19 +636,17 @@ def measured_state(c, x, xd, m):  # type: ignore[no-untyped-def]
 def simulate_chained_into(x, dt, substeps, rows, knots, coef, starts, lens, init, out_u, out_t1):  # type: ignore[no-untyped-def]
     """``simulate_segments_into`` segment after segment per row (parallel over rows only).
 
-    The string modes, the LuGre bristle and the pulley seat are not observable from the
-    gauges at a start (a ringing span's phase; the bristle's pre-sliding while sticking;
-    which groove the fibre sits in, a step of a tenth of a millimetre in a noisy
-    elongation), but they are driven by the tension and the weight's motion: simulating
-    them is their observer. So every segment after the first starts them where the
-    previous segment's run had them at that sample; everything else starts from
-    ``measured_state`` as before.
+    The string modes and the LuGre bristle are not observable from the gauges at a start
+    (a ringing span's phase; the bristle's pre-sliding while sticking), but they are
+    driven by the tension and the weight's motion: simulating them is their observer. So
+    every segment after the first starts them where the previous segment's run had them
+    at that sample; everything else starts from ``measured_state`` as before (the pulley
+    seat from the recorded slack episodes, ``measured_seats``).
     """
     sets = rows.shape[0]
     segs = starts.shape[0]
     for b in prange(sets):
         carried = np.zeros(NY - Y_A1)
-        seat = np.zeros(3)  # the pulley-jump seat: S_LOFF, S_LBASE, S_DEPTH
         have = False
         for s in range(segs):
             n = lens[s]
@@ -631,7 +667,6 @@ def simulate_chained_into(x, dt, substeps, rows, knots, coef, starts, lens, init
                         y[0], y[1], y[2], y[3], y[4], y[5],
                         carried[0], carried[1], carried[2], carried[3], carried[4],
                     )  # fmt: skip
-                    c[S_LOFF], c[S_LBASE], c[S_DEPTH] = seat[0], seat[1], seat[2]
                 _set_taut(c, y, xs[0], xd)
                 _sample_out(c, y, xs[0], xd, 0, ou, sv, ot, st2)
             state = np.empty(NY)
@@ -643,7 +678,6 @@ def simulate_chained_into(x, dt, substeps, rows, knots, coef, starts, lens, init
                 advance_into(xs[:h1], dt, substeps, c, state, ou[:h1], sv[:h1], ot[:h1], st2[:h1])
                 for k in range(NY - Y_A1):
                     carried[k] = state[Y_A1 + k]
-                seat[0], seat[1], seat[2] = c[S_LOFF], c[S_LBASE], c[S_DEPTH]
                 have = True
                 tail = slice(hand, n)
                 advance_into(

@@ -61,6 +61,11 @@ class ParamInfo:
     drawn: bool | None = None  # varies between drawn stands (None: as ``fit``)
     bounds: tuple[float, float] = (0.0, 0.0)  # physical range: fitting bounds
     why: str = ""  # why the physical range is what it is
+    #: A threshold on recorded events (e.g. how long a slack episode must last): the
+    #: output error changes in steps as it crosses the episodes, so a gradient cannot
+    #: move it. Fitted by scanning (``scan`` levels, refined between the best's
+    #: neighbours), held fixed in the local fits. Empty: fitted by gradient.
+    scan: tuple[float, ...] = ()
 
     @property
     def fit_low(self) -> float:
@@ -173,9 +178,10 @@ class EffectSpec:
 def _p(name: str, unit: str, default: float, plausible: tuple[float, float],
        admissible: tuple[float, float], column: int, description: str, *,
        fit: bool = True, log: bool = False, drawn: bool | None = None,
-       bounds: tuple[float, float] = (0.0, 0.0), why: str = "") -> ParamInfo:
+       bounds: tuple[float, float] = (0.0, 0.0), why: str = "",
+       scan: tuple[float, ...] = ()) -> ParamInfo:
     return ParamInfo(name, unit, default, *plausible, *admissible, description, column, fit, log,
-                     drawn, bounds, why)
+                     drawn, bounds, why, scan)
 
 
 _INFOS = (
@@ -220,8 +226,8 @@ _INFOS = (
     ),
     EffectInfo(
         "fibre_pulley_jump", "physical",
-        "once the slack is onset_m deep the fibre leaves its groove and re-seats in the other "
-        "of two seats, changing the effective length by "
+        "once the slack is onset_m deep and has lasted dwell_s the fibre leaves its groove and "
+        "re-seats in the other of two seats, changing the effective length by "
         "step_m·(1 − exp(−(slack depth − onset_m)/depth_scale_m))",
         "offset steps in force and position right after slack episodes",
         ek.R_PJ_ON,
@@ -240,6 +246,14 @@ _INFOS = (
                "slack depth at which the fibre leaves its groove", bounds=(0.0, 5.0e-3),
                why="a fibre held in its groove by friction leaves it only once its loop is "
                    "as deep as the groove or the flange: 0 to a few millimetres"),
+            _p("dwell_s", "s", 0.0, (0.0, 0.05), (0.0, 1.0), ek.R_PJ_DWELL,
+               "time the fibre lies slack before it leaves its groove", bounds=(0.0, 0.2),
+               why="a loose loop slides out of a groove a few millimetres deep under its own "
+                   "weight and the groove's friction within tens of milliseconds "
+                   "(free fall over 1–10 mm takes 14–45 ms); at once when it is flicked out",
+               # 0, then 2 ms to 0.2 s in steps of 20 %: finer than the spread of the
+               # slack episodes' lengths (tens of ms) the threshold must fall between.
+               scan=(0.0, *(float(v) for v in np.geomspace(2.0e-3, 0.2, 26)))),
         ),
     ),
     EffectInfo(

@@ -29,7 +29,13 @@ import numpy as np
 
 from sim.effects import EFFECTS
 from sim.identify.decide import Evidence, compare
-from sim.identify.fitting import Candidate, FitResult, effect_grid_start, fit
+from sim.identify.fitting import (
+    Candidate,
+    FitResult,
+    effect_grid_start,
+    fit,
+    scan_thresholds,
+)
 from sim.identify.heldout import (
     Outputs,
     bootstrap_confidence,
@@ -78,11 +84,28 @@ def _refit(
     start_from: dict[str, float],
     extra: Sequence[dict[str, float]] = (),
 ) -> _Fitted:
-    """Grid start over the new effect's parameters, then a short local refit of all."""
+    """Grid start over the new effect's parameters, then a short local refit of all.
+
+    An effect with thresholds (``FreeParam.scan``) has them scanned after the local
+    refit, and is refitted once more from the scan's point if that lowered the cost.
+    """
     start = effect_grid_start(candidate, traces, nominal, start_from, extra)
     res = fit(
         candidate, traces, nominal, baseline=start, single_start=True, max_nfev=REFIT_EVALUATIONS
     )
+    if any(p.scan for p in candidate.params):
+        scanned, cost, sims = scan_thresholds(candidate, traces, nominal, res.values)
+        if cost < res.train_cost:
+            again = fit(
+                candidate, traces, nominal, baseline=scanned, single_start=True,
+                max_nfev=REFIT_EVALUATIONS,
+            )  # fmt: skip
+            better = again if again.train_cost < cost else FitResult(candidate, scanned, cost, 0)
+            res = dataclasses.replace(
+                better, evaluations=res.evaluations + sims + again.evaluations
+            )
+        else:
+            res = dataclasses.replace(res, evaluations=res.evaluations + sims)
     outs = outputs_of(res.candidate, res.values, traces, nominal)
     return _Fitted(res, outs, heldout_excess(traces, outs))
 

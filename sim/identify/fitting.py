@@ -55,6 +55,8 @@ class FreeParam:
     width: float = 1.0
     #: Where the value typically lies (the start grid is densest there); None: everywhere.
     typical: tuple[float, float] | None = None
+    #: Levels (natural units) of a threshold fitted by scanning, held in local fits.
+    scan: tuple[float, ...] = ()
 
     def to_internal(self, value: float) -> float:
         """Natural value → optimiser coordinate."""
@@ -87,11 +89,11 @@ def _free(effect: str, p: ParamInfo) -> FreeParam:
     """An effect parameter as fitted: within its physical range (``ParamInfo.bounds``)."""
     low, high, typical = p.fit_low, p.fit_high, (p.low, p.high)
     if p.log and low > 0:
-        return FreeParam(f"{effect}.{p.name}", low, high, "log", typical=typical)
+        return FreeParam(f"{effect}.{p.name}", low, high, "log", typical=typical, scan=p.scan)
     if p.log:  # signed, spanning decades
         width = max(abs(p.low), abs(p.high)) / 4
-        return FreeParam(f"{effect}.{p.name}", low, high, "asinh", width, typical)
-    return FreeParam(f"{effect}.{p.name}", low, high, typical=typical)
+        return FreeParam(f"{effect}.{p.name}", low, high, "asinh", width, typical, p.scan)
+    return FreeParam(f"{effect}.{p.name}", low, high, typical=typical, scan=p.scan)
 
 
 @dataclass
@@ -231,14 +233,15 @@ class Objective:
             self._cache = {key: self.residuals_batch(np.atleast_2d(z))[0]}
         return self._cache[key]
 
-    def jacobian(self, z: FloatArray) -> FloatArray:
-        """Forward differences, all columns in one batch (plus the base point)."""
+    def jacobian(self, z: FloatArray, columns: NDArray[np.bool_] | None = None) -> FloatArray:
+        """Forward differences of the chosen columns (default: all), in one batch."""
         lo = np.array([p.bounds()[0] for p in self.candidate.params])
         hi = np.array([p.bounds()[1] for p in self.candidate.params])
         step = 1e-3 * (hi - lo)
+        which = np.flatnonzero(np.ones(z.size, bool) if columns is None else columns)
         zs = [z]
         signs = []
-        for i in range(z.size):
+        for i in which:
             zi = z.copy()
             sign = 1.0 if z[i] + step[i] <= hi[i] else -1.0
             zi[i] += sign * step[i]
@@ -246,7 +249,7 @@ class Objective:
             signs.append(sign)
         r = self.residuals_batch(np.stack(zs))
         self._cache = {np.asarray(z, dtype=np.float64).tobytes(): r[0]}
-        cols = [(r[i + 1] - r[0]) / (signs[i] * step[i]) for i in range(z.size)]
+        cols = [(r[k + 1] - r[0]) / (signs[k] * step[i]) for k, i in enumerate(which)]
         return np.stack(cols, axis=1)
 
 
@@ -369,15 +372,58 @@ def fit(
                 ]
             )
         ]
+    # Thresholds (``FreeParam.scan``) stay where the start put them: a gradient cannot
+    # move a parameter whose output error changes in steps.
+    free = np.array([not p.scan for p in candidate.params])
     for start in starts:
         z0 = np.clip(start, lo + 1e-9 * (hi - lo), hi - 1e-9 * (hi - lo))
+
+        def full(zf: FloatArray, z0: FloatArray = z0) -> FloatArray:
+            z = z0.copy()
+            z[free] = zf
+            return z
+
         sol = least_squares(
-            objective.residuals, z0, jac=objective.jacobian, bounds=(lo, hi),
-            method="trf", x_scale="jac", max_nfev=max_nfev, xtol=1e-6, ftol=1e-8,
+            lambda zf, full=full: objective.residuals(full(zf)), z0[free],
+            jac=lambda zf, full=full: objective.jacobian(full(zf), free),
+            bounds=(lo[free], hi[free]), method="trf", x_scale="jac", max_nfev=max_nfev,
+            xtol=1e-6, ftol=1e-8,
         )  # fmt: skip
         cost = float(np.sum(sol.fun**2))
         log.debug("%s start %s -> cost %.6g (%d evals)", candidate.name, z0, cost, sol.nfev)
         if best is None or cost < best[0]:
-            best = (cost, sol.x)
+            best = (cost, full(sol.x))
     assert best is not None
     return FitResult(candidate, candidate.natural(best[1]), best[0], objective.simulations)
+
+
+def scan_thresholds(
+    candidate: Candidate,
+    traces: Sequence[Trace],
+    nominal: StandParams,
+    values: dict[str, float],
+    stride: int = 4,
+) -> tuple[dict[str, float], float, int]:
+    """Each threshold parameter scanned at the others' values: (values, cost, simulations).
+
+    One batch over its levels, then one between the best level's neighbours (9 points):
+    the cost is a step function of a threshold, flat between the recorded episodes it
+    separates, so only a scan finds the step that matters.
+    """
+    objective = Objective(candidate, traces, nominal, stride)
+    z = np.array([p.to_internal(values[p.name]) for p in candidate.params])
+    cost = float(np.sum(objective.residuals(z) ** 2))
+    for i, p in enumerate(candidate.params):
+        if not p.scan:
+            continue
+        levels = np.array([p.to_internal(float(np.clip(v, p.low, p.high))) for v in p.scan])
+        for _ in range(2):
+            zs = np.repeat(z[None, :], levels.size, axis=0)
+            zs[:, i] = levels
+            costs = np.sum(objective.residuals_batch(zs) ** 2, axis=1)
+            j = int(np.argmin(costs))
+            if costs[j] < cost:
+                cost, z = float(costs[j]), zs[j].copy()
+            lo_j, hi_j = levels[max(j - 1, 0)], levels[min(j + 1, levels.size - 1)]
+            levels = np.linspace(lo_j, hi_j, 11)[1:-1]
+    return candidate.natural(z), cost, objective.simulations

@@ -109,20 +109,21 @@ def cycle_improvements(
     return block_improvements(traces, before, after, block_s=math.inf)
 
 
-def block_improvements(
+def block_errors(
     traces: Sequence[Trace],
     before: Sequence[Outputs],
     after: Sequence[Outputs],
     block_s: float = BLOCK_S,
-) -> FloatArray:
-    """Per held-out block: drop in mean squared error in noise units (positive = better).
+) -> tuple[FloatArray, FloatArray]:
+    """Per held-out block: mean squared error in noise units, before and after.
 
     Held-out cycles are cut into blocks of about ``block_s`` (at least one per cycle):
     long enough that a block's errors are nearly independent of its neighbours' (the
     fibre's ringing dies out within a tenth of a second), short enough that a campaign
-    with few held-out cycles still gives a test some power.
+    with few held-out cycles still gives a test some power. Both channels are summed,
+    each over its own noise.
     """
-    gains = []
+    errors: list[tuple[float, float]] = []
     for tr, b, a in zip(traces, before, after, strict=True):
         idx = tr.test
         scales = [
@@ -133,16 +134,27 @@ def block_improvements(
             samples = np.flatnonzero(idx & (tr.cycle == c))
             pieces = max(1, int(samples.size // (block_s * tr.rate_hz)))
             for sel in np.array_split(samples, pieces):
-                total = 0.0
+                eb, ea = 0.0, 0.0
                 for rec, sb, sa, scale in (
                     (tr.u_m, b.u_m, a.u_m, scales[0]),
                     (tr.force_n, b.force_n, a.force_n, scales[1]),
                 ):
-                    eb = np.mean((sb[sel] - rec[sel]) ** 2)
-                    ea = np.mean((sa[sel] - rec[sel]) ** 2)
-                    total += float(eb - ea) / scale**2
-                gains.append(total)
-    return np.asarray(gains)
+                    eb += float(np.mean((sb[sel] - rec[sel]) ** 2)) / scale**2
+                    ea += float(np.mean((sa[sel] - rec[sel]) ** 2)) / scale**2
+                errors.append((eb, ea))
+    pairs = np.asarray(errors, dtype=np.float64).reshape(-1, 2)
+    return pairs[:, 0], pairs[:, 1]
+
+
+def block_improvements(
+    traces: Sequence[Trace],
+    before: Sequence[Outputs],
+    after: Sequence[Outputs],
+    block_s: float = BLOCK_S,
+) -> FloatArray:
+    """Per held-out block: drop in mean squared error in noise units (positive = better)."""
+    eb, ea = block_errors(traces, before, after, block_s)
+    return eb - ea
 
 
 def bootstrap_confidence(gains: FloatArray, rounds: int = 2000, seed: int = 0) -> float:
