@@ -12,7 +12,7 @@ from __future__ import annotations
 import json
 import os
 from collections.abc import Mapping
-from dataclasses import replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -22,18 +22,28 @@ from numpy.typing import NDArray
 
 from recordings.base import EVENTS_DTYPE, register_format
 from recordings.csvtext import CsvOptions, CsvText, split_csv
-from recordings.errors import ImportMappingError
+from recordings.errors import CorruptRecordingError, ImportMappingError
 from recordings.foreign import FIELDS, ColumnMap, build_recording, resolve, to_unit
 from recordings.recording import Recording
-from recordings.schema import RecordingMetadata
+from recordings.schema import DRIVE_DTYPE, RecordingMetadata
 from sim.config import default_config
 
-__all__ = ["EVENT_TAG", "HEADER", "METADATA_TAG", "CsvOptions", "read_csv", "write_csv"]
+__all__ = [
+    "DRIVE_TAG",
+    "EVENT_TAG",
+    "HEADER",
+    "METADATA_TAG",
+    "CsvOptions",
+    "drive_array",
+    "read_csv",
+    "write_csv",
+]
 
 HEADER = "t_s,x_mm,u_mm,F_N"
 #: Preamble lines ``labstand convert`` writes: the metadata and the events as JSON.
 METADATA_TAG = "# labstand-metadata: "
 EVENT_TAG = "# labstand-event: "
+DRIVE_TAG = "# labstand-drive: "
 _NOTE_CHARS = 300  # of a foreign preamble kept in the operator note
 
 
@@ -76,26 +86,46 @@ def _numeric(
     return values
 
 
-def _stored(text: CsvText) -> tuple[RecordingMetadata | None, list[tuple[int, str, str]], str]:
-    """What a labstand preamble says (metadata, events), and the other preamble lines."""
+def drive_array(polls: list[dict[str, Any]], where: str) -> NDArray[np.void]:
+    """Drive polls exported as JSON objects (one per poll) as a ``DRIVE_DTYPE`` array."""
+    drive = np.empty(len(polls), dtype=DRIVE_DTYPE)
+    try:
+        for name in DRIVE_DTYPE.names or ():
+            drive[name] = [p[name] for p in polls]
+    except (KeyError, TypeError, ValueError) as err:
+        raise CorruptRecordingError(f"{where}: unreadable drive polls: {err!r}") from None
+    return drive
+
+
+@dataclass
+class _Stored:
+    """What a labstand preamble says, and the other preamble lines as one note."""
+
     meta: RecordingMetadata | None = None
-    events: list[tuple[int, str, str]] = []
+    events: list[tuple[int, str, str]] = field(default_factory=list)
+    drive: list[dict[str, Any]] = field(default_factory=list)
+    note: str = ""
+
+
+def _stored(text: CsvText) -> _Stored:
+    out = _Stored()
     other: list[str] = []
     for line in text.preamble:
         try:
             if line.startswith(METADATA_TAG):
-                meta = RecordingMetadata.from_json(line[len(METADATA_TAG) :], text.where)
+                out.meta = RecordingMetadata.from_json(line[len(METADATA_TAG) :], text.where)
             elif line.startswith(EVENT_TAG):
                 e = json.loads(line[len(EVENT_TAG) :])
-                events.append((int(e["t_ns"]), str(e["kind"]), str(e["text"])))
+                out.events.append((int(e["t_ns"]), str(e["kind"]), str(e["text"])))
+            elif line.startswith(DRIVE_TAG):
+                out.drive.append(json.loads(line[len(DRIVE_TAG) :]))
             else:
                 other.append(line.strip())
         except (ValueError, KeyError, TypeError) as err:
             raise ImportMappingError(f"{text.where}: unreadable labstand preamble: {err}") from None
     note = " / ".join(other)
-    if len(note) > _NOTE_CHARS:
-        note = note[: _NOTE_CHARS - 1] + "…"
-    return meta, events, note
+    out.note = note if len(note) <= _NOTE_CHARS else note[: _NOTE_CHARS - 1] + "…"
+    return out
 
 
 def read_csv(
@@ -142,7 +172,8 @@ def read_csv(
     counters = {
         c: _numeric(frame, c, text).astype(np.int64) for c in ("seq", "flags") if c in frame
     }
-    stored, events, note = _stored(text)
+    kept = _stored(text)
+    stored = kept.meta
     config = stand_config
     if config is None:
         config = stored.stand_config if stored else default_config().to_dict()
@@ -154,11 +185,13 @@ def read_csv(
         rate_hz=stored.sample_rate_hz if stored else None,
         seq=counters.get("seq"),
         flags=counters.get("flags"),
-        preamble=note,
+        preamble=kept.note,
     )
     if stored is not None:
         recording.metadata = replace(stored, stand_config=config)
+        events = kept.events
         recording.events_array = np.array(events, dtype=EVENTS_DTYPE).reshape(len(events))
+        recording.drive = drive_array(kept.drive, where)
     return recording
 
 
