@@ -123,6 +123,10 @@ def summary(recording: Recording) -> dict[str, Any]:
         "channels": channels,
         "drive_states": len(recording.drive),
         "events": len(recording.events_array),
+        "event_list": [
+            {"t_s": int(t) / 1e9, "kind": str(k), "text": str(x)}
+            for t, k, x in recording.events_array.tolist()
+        ],
         "repairs": list(recording.repairs),
         "metadata": meta_dict,
     }
