@@ -16,7 +16,8 @@ Exceptions::
           ├── TruncatedRecordingError the writer was killed: run ``labstand recover``
           ├── CorruptRecordingError   a failed checksum, bytes that do not decode
           ├── InvalidDataError        NaNs, time or sequence not increasing, bad blocks
-          └── ImportMappingError      CSV/TDMS columns that cannot be mapped
+          ├── ImportMappingError      CSV/TDMS columns that cannot be mapped, bad CSV lines
+          └── WindowError             a time window outside the recording (recordings.window)
 """
 
 from recordings import csvio, hdf5io, mcap_reader, mcap_writer, tables, tdmsio
