@@ -85,3 +85,14 @@ def test_diagnose_takes_the_mass_as_replay_does(light_csv: Path, tmp_path: Path,
     paper = load_config(None)
     assert _mass_of(rec, stored, None, paper) == (8.131, f"default weight of {paper.source}")
     assert _mass_of(rec, {"weights_kg": "x"}, None, None)[0] == 8.131
+
+
+def test_tdms_import_stores_the_mass_too(tmp_path: Path, capsys):
+    from .test_import import MAP, _tdms
+
+    src, rec = tmp_path / "legacy.tdms", tmp_path / "legacy.h5"
+    _tdms(src)
+    assert main(["import", str(src), *MAP, "--mass-kg", "3.096", "-o", str(rec)]) == 0
+    assert "weight 3.096 kg (--mass-kg)" in capsys.readouterr().out
+    stored = open_recording(rec).metadata.stand_config
+    assert stored["weights_kg"][stored["weight"]["default"]] == 3.096
