@@ -78,6 +78,8 @@ def run(args: argparse.Namespace) -> int:
             sys.stdout.write(f"{t_ns / 1e9:.6f}\t{kind}\t{flat}\n")
         return 0
     columns = columns_for(args.channels, len(rec.command) > 0)
+    if "x_cmd_mm" in columns and not len(rec.command):
+        raise CommandError(f"{args.recording}: has no command stream (x_cmd)", ExitCode.USAGE)
     frame = rec.frame().reset_index()
     # floats by repr: the shortest text that reads back to the same number
     frame[["t_s", *columns]].to_csv(sys.stdout, index=False, lineterminator="\n")

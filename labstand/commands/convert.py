@@ -47,6 +47,8 @@ def check_target(target: Path, source: Path) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Read A, write B."""
+    import numpy as np
+
     from recordings import open_recording
     from recordings.convert import write_recording
 
@@ -54,4 +56,10 @@ def run(args: argparse.Namespace) -> int:
     recording = open_recording(args.source)
     write_recording(recording, args.target)
     print(f"Converted {args.source} → {args.target} ({len(recording.gauges)} samples)")
+    command, gauges = recording.command, recording.gauges
+    table = args.target.suffix.lower() in {".csv", ".parquet"}
+    if table and len(command) and not np.array_equal(command["t_ns"], gauges["t_ns"]):
+        print(
+            "  note: the command has a clock of its own; written at the gauge times, interpolated"
+        )
     return 0

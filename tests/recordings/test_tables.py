@@ -116,3 +116,20 @@ def test_convert_refuses_what_it_cannot_write(rich_mcap: Path, tmp_path: Path, c
     bad.write_bytes(b"PAR1 not really")
     assert main(["convert", str(bad), str(tmp_path / "x.mcap")]) == 2
     assert "not a readable Parquet file" in capsys.readouterr().err
+
+
+def test_a_command_on_its_own_clock_is_exported_interpolated_and_said(
+    tmp_path: Path, meta: RecordingMetadata, capsys
+):
+    src, out = tmp_path / "own.mcap", tmp_path / "own.csv"
+    c = command(1000)
+    c["t_ns"] += 250_000  # halfway between gauge samples
+    write_streams(src, meta, gauges(1000), c)
+    assert main(["convert", str(src), str(out)]) == 0
+    assert "the command has a clock of its own; written at the gauge times" in (
+        capsys.readouterr().out
+    )
+    np.testing.assert_array_equal(
+        open_recording(out).frame()["x_cmd_mm"].dropna(),
+        open_recording(src).frame()["x_cmd_mm"].dropna(),
+    )

@@ -139,6 +139,20 @@ def test_trim_writes_the_window_with_its_events_and_a_note(
     )
 
 
+def test_cat_of_a_recording_without_command(tmp_path: Path, capsys):
+    src, rec = tmp_path / "run.csv", tmp_path / "run.mcap"
+    src.write_text("t_s,x_mm,u_mm,F_N\n0,1,2,3\n0.0005,1.5,2,3\n0.001,2,2,3\n", encoding="utf-8")
+    assert main(["import", str(src), "-o", str(rec)]) == 0
+    capsys.readouterr()
+    assert main(["cat", str(rec), "--start", "0.0005"]) == 0
+    assert (
+        capsys.readouterr().out
+        == "t_s,x_mm,u_mm,F_N,seq,flags\n0.0005,1.5,2.0,3.0,1,0\n0.001,2.0,2.0,3.0,2,0\n"
+    )
+    assert main(["cat", str(rec), "--channels", "x_cmd"]) == 2
+    assert capsys.readouterr().err == f"labstand: error: {rec}: has no command stream (x_cmd)\n"
+
+
 def test_trim_refuses_bad_input(rich_mcap: Path, tmp_path: Path, capsys):
     out = tmp_path / "part.mcap"
     for args, message in [
