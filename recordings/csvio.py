@@ -22,7 +22,7 @@ from numpy.typing import NDArray
 
 from recordings.base import EVENTS_DTYPE, register_format
 from recordings.csvtext import CsvOptions, CsvText, split_csv
-from recordings.errors import CorruptRecordingError, ImportMappingError
+from recordings.errors import CorruptRecordingError, ImportMappingError, RecordingError
 from recordings.foreign import FIELDS, ColumnMap, build_recording, resolve, to_unit
 from recordings.recording import Recording
 from recordings.schema import DRIVE_DTYPE, RecordingMetadata
@@ -121,6 +121,8 @@ def _stored(text: CsvText) -> _Stored:
                 out.drive.append(json.loads(line[len(DRIVE_TAG) :]))
             else:
                 other.append(line.strip())
+        except RecordingError:  # the metadata's own complaint (newer schema, ...)
+            raise
         except (ValueError, KeyError, TypeError) as err:
             raise ImportMappingError(f"{text.where}: unreadable labstand preamble: {err}") from None
     note = " / ".join(other)
