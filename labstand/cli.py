@@ -33,6 +33,8 @@ COMMANDS = [
     "info",
     "import_",
     "convert",
+    "cat",
+    "trim",
     "recover",
     "diagnose",
     "diagnose_check",

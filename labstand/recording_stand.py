@@ -23,12 +23,23 @@ def stand_of(recording: Recording, stand_file: Path | None) -> StandConfig:
         raise CommandError(f"{err}; give the stand with --stand FILE", ExitCode.USAGE) from None
 
 
+def mass_source(recording: Recording, stand_file: Path | None, mass_kg: float | None) -> str:
+    """Where the mass ``params_for`` uses comes from, for the command's output."""
+    if mass_kg is not None:
+        return "--mass-kg"
+    if stand_file is not None:
+        return f"default weight of {stand_file}"
+    return "stored in the recording"
+
+
 def params_for(
     recording: Recording, stand_file: Path | None, params: str, mass_kg: float | None
 ) -> tuple[StandParams, str]:
     """Model parameters for a replay: a named set, or a stand FILE whose 'final' set is used.
 
-    The mass is --mass-kg, else the weight stored in the recording's stand.
+    The mass is --mass-kg, else the default weight of the stand file if one is given, else
+    the weight stored in the recording's stand (``run --mass-kg``, ``import --mass-kg``);
+    ``mass_source`` says which.
     """
     config = stand_of(recording, stand_file)
     name = params

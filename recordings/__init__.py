@@ -1,8 +1,9 @@
 """Recordings: one schema (docs/recording-format.md), MCAP and HDF5 files, imports.
 
 ``open_writer(path, metadata)`` streams a recording into ``.mcap`` or ``.h5``;
-``open_recording(path)`` reads ``.mcap``, ``.h5``/``.hdf5``, ``.csv`` and ``.tdms`` into a
-checked ``Recording`` (``.metadata``, ``.frame()``, ``.drive_states()``, ``.events()``).
+``open_recording(path)`` reads ``.mcap``, ``.h5``/``.hdf5``, ``.csv``, ``.parquet`` and
+``.tdms`` into a checked ``Recording`` (``.metadata``, ``.frame()``, ``.drive_states()``,
+``.events()``).
 
 Exceptions::
 
@@ -15,10 +16,11 @@ Exceptions::
           ├── TruncatedRecordingError the writer was killed: run ``labstand recover``
           ├── CorruptRecordingError   a failed checksum, bytes that do not decode
           ├── InvalidDataError        NaNs, time or sequence not increasing, bad blocks
-          └── ImportMappingError      CSV/TDMS columns that cannot be mapped
+          ├── ImportMappingError      CSV/TDMS columns that cannot be mapped, bad CSV lines
+          └── WindowError             a time window outside the recording (recordings.window)
 """
 
-from recordings import csvio, hdf5io, mcap_reader, mcap_writer, tdmsio
+from recordings import csvio, hdf5io, mcap_reader, mcap_writer, tables, tdmsio
 from recordings.base import RecordingWriter, open_writer
 from recordings.errors import (
     CorruptRecordingError,
@@ -70,6 +72,7 @@ __all__ = [
     "mcap_writer",
     "open_recording",
     "open_writer",
+    "tables",
     "tdmsio",
     "unwrap_u16",
 ]

@@ -10,9 +10,10 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from recordings.base import open_writer
+from recordings.base import EVENTS_DTYPE, open_writer
 from recordings.recording import Recording
 from recordings.schema import COMMAND_DTYPE, DRIVE_DTYPE, RecordingMetadata
+from recordings.tables import TABLE_SUFFIXES, write_table
 
 __all__ = ["summary", "with_changes", "write_recording", "write_streams"]
 
@@ -78,13 +79,21 @@ def _next_end(gauges: NDArray[np.void], g_at: int, command: NDArray[np.void], c_
 def write_recording(
     recording: Recording, path: Path, metadata: RecordingMetadata | None = None
 ) -> None:
-    """Write a recording (or a salvaged or imported one) to ``path`` (format by suffix)."""
+    """Write a recording (or a salvaged or imported one) to ``path`` (format by suffix).
+
+    ``.mcap``/``.h5`` stream through a writer; ``.csv``/``.parquet`` are written as one
+    table on the gauge clock (``recordings.tables``).
+    """
     meta = metadata or recording.metadata
     events = [(int(t), str(k), str(x)) for t, k, x in recording.events_array.tolist()]
     for line in recording.repairs:
         t_ns = int(recording.gauges["t_ns"][-1]) if len(recording.gauges) else 0
         events.append((t_ns, "repair", line))
-    write_streams(path, meta, recording.gauges, recording.command, recording.drive, events)
+    if path.suffix.lower() in TABLE_SUFFIXES:
+        array = np.array(events, dtype=EVENTS_DTYPE).reshape(len(events))
+        write_table(dataclasses.replace(recording, events_array=array, repairs=[]), path, meta)
+    else:
+        write_streams(path, meta, recording.gauges, recording.command, recording.drive, events)
     log.info("wrote %s (%d samples)", path, len(recording.gauges))
 
 
@@ -114,6 +123,10 @@ def summary(recording: Recording) -> dict[str, Any]:
         "channels": channels,
         "drive_states": len(recording.drive),
         "events": len(recording.events_array),
+        "event_list": [
+            {"t_s": int(t) / 1e9, "kind": str(k), "text": str(x)}
+            for t, k, x in recording.events_array.tolist()
+        ],
         "repairs": list(recording.repairs),
         "metadata": meta_dict,
     }

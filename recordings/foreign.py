@@ -130,12 +130,16 @@ def build_recording(
     rate_hz: float | None = None,
     start: datetime | None = None,
     repairs: list[str] | None = None,
+    seq: NDArray[np.int64] | None = None,
+    flags: NDArray[np.int64] | None = None,
+    preamble: str = "",
 ) -> Recording:
     """A Recording from imported columns in schema units (x, u, F and maybe x_cmd).
 
     The sequence counter is rebuilt from time: ``seq = round((t − t₀)·rate)``, so a gap
-    in the time column shows as lost samples. The rate is the median sample spacing's
-    unless given.
+    in the time column shows as lost samples (unless the file has its own ``seq``). The
+    rate is the median sample spacing's unless given. ``x_cmd`` may be NaN where there
+    was no command. ``preamble`` (the file's own header text) goes into the operator note.
     """
     where = str(path)
     n = len(t_s)
@@ -149,16 +153,18 @@ def build_recording(
     t_ns = np.round(t_s * 1e9).astype(np.int64)
     gauges = np.empty(n, dtype=GAUGES_DTYPE)
     gauges["t_ns"] = t_ns
-    gauges["seq"] = np.round((t_s - t_s[0]) * rate_hz).astype(np.int64)
+    gauges["seq"] = seq if seq is not None else np.round((t_s - t_s[0]) * rate_hz)
     gauges["x_mm"] = values_mm_n["x"]
     gauges["u_mm"] = values_mm_n["u"]
     gauges["force_n"] = values_mm_n["F"]
-    gauges["flags"] = 0
+    gauges["flags"] = flags if flags is not None else 0
     command = np.empty(0, dtype=COMMAND_DTYPE)
     if "x_cmd" in values_mm_n:
-        command = np.empty(n, dtype=COMMAND_DTYPE)
-        command["t_ns"] = t_ns
-        command["x_cmd_mm"] = values_mm_n["x_cmd"]
+        x_cmd = values_mm_n["x_cmd"]
+        present = np.isfinite(x_cmd)
+        command = np.empty(int(present.sum()), dtype=COMMAND_DTYPE)
+        command["t_ns"] = t_ns[present]
+        command["x_cmd_mm"] = x_cmd[present]
     if start is None:
         start = datetime.fromtimestamp(path.stat().st_mtime, tz=UTC)
         start_note = "start time taken from the file's modification time"
@@ -168,7 +174,8 @@ def build_recording(
         stand_config,
         Backend.IMPORT,
         sample_rate_hz=float(rate_hz),
-        operator_note=f"imported from {path.name}; {start_note}",
+        operator_note=f"imported from {path.name}; {start_note}"
+        + (f"; the file's preamble: {preamble}" if preamble else ""),
         source=path.name,
         start=start,
     )

@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from typing import Any
 
-from sim.config import StandConfig, load_config
+from sim.config import StandConfig, config_from_dict, load_config
 
 
 def add_stand_options(parser: argparse.ArgumentParser, params: bool = False) -> None:
@@ -25,3 +26,22 @@ def add_stand_options(parser: argparse.ArgumentParser, params: bool = False) -> 
 def load_stand(args: argparse.Namespace) -> StandConfig:
     """The stand configuration the user chose, validated."""
     return load_config(getattr(args, "stand", None))
+
+
+def config_with_mass(config: StandConfig, mass_kg: float) -> dict[str, Any]:
+    """The stand configuration whose default weight is the mass on the stand.
+
+    This is how a recording stores the weight it was made with (``run``, ``import``):
+    later commands read it as the stored stand's default weight.
+    """
+    raw = config.to_dict()
+    weights = raw["weights_kg"]
+    name = next((n for n, m in weights.items() if m == mass_kg), None)
+    if name is None:
+        name = next(
+            f"run{i or ''}" for i in range(len(weights) + 1) if f"run{i or ''}" not in weights
+        )
+        weights[name] = mass_kg
+    raw["weight"]["default"] = name
+    config_from_dict(raw, config.source)  # still valid
+    return raw

@@ -1,4 +1,4 @@
-"""``labstand convert``: one recording format into another (MCAP ↔ HDF5), losslessly."""
+"""``labstand convert``: one recording format into another (MCAP, HDF5, CSV, Parquet)."""
 
 from __future__ import annotations
 
@@ -6,28 +6,60 @@ import argparse
 from pathlib import Path
 
 from labstand.errors import CommandError, ExitCode
-from recordings import open_recording
-from recordings.convert import write_recording
 
 
 def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Add ``labstand convert``."""
     parser = sub.add_parser(
         "convert",
-        help="convert a recording between MCAP and HDF5",
+        help="convert a recording between MCAP, HDF5, CSV and Parquet",
         description="Convert recording A into B; the suffixes pick the formats (.mcap, .h5, "
-        ".hdf5). Every stream and the metadata are copied as they are.",
+        ".hdf5, .csv, .parquet). MCAP and HDF5 copy every stream and the metadata as they "
+        "are. CSV and Parquet hold one table on the gauge clock (t, x_mm, u_mm, F_N, "
+        "x_cmd_mm, seq, flags; units in the CSV header and the Parquet schema) and carry the "
+        "metadata, events and drive polls along (CSV: '# labstand-...' preamble lines; "
+        "Parquet: key-value metadata), so they convert back losslessly.",
     )
     parser.add_argument("source", type=Path, metavar="A", help="recording to read")
     parser.add_argument("target", type=Path, metavar="B", help="recording to write")
     parser.set_defaults(func=run)
 
 
+def writable_suffixes() -> list[str]:
+    """Every suffix ``write_recording`` writes."""
+    from recordings.base import FORMATS
+    from recordings.tables import TABLE_SUFFIXES
+
+    return sorted({s for s, (_, writer, _) in FORMATS.items() if writer} | set(TABLE_SUFFIXES))
+
+
+def check_target(target: Path, source: Path) -> None:
+    """Refuse (exit 2) a target that cannot be written or would overwrite the source."""
+    if target.suffix.lower() not in writable_suffixes():
+        raise CommandError(
+            f"{target}: cannot write {target.suffix or 'files without a suffix'!r}; "
+            f"use one of {', '.join(writable_suffixes())}",
+            ExitCode.USAGE,
+        )
+    if source.resolve() == target.resolve():
+        raise CommandError(f"{target}: would overwrite the source", ExitCode.USAGE)
+
+
 def run(args: argparse.Namespace) -> int:
     """Read A, write B."""
-    if args.source.resolve() == args.target.resolve():
-        raise CommandError(f"{args.target}: would overwrite the source", ExitCode.USAGE)
+    import numpy as np
+
+    from recordings import open_recording
+    from recordings.convert import write_recording
+
+    check_target(args.target, args.source)
     recording = open_recording(args.source)
     write_recording(recording, args.target)
     print(f"Converted {args.source} → {args.target} ({len(recording.gauges)} samples)")
+    command, gauges = recording.command, recording.gauges
+    table = args.target.suffix.lower() in {".csv", ".parquet"}
+    if table and len(command) and not np.array_equal(command["t_ns"], gauges["t_ns"]):
+        print(
+            "  note: the command has a clock of its own; written at the gauge times, interpolated"
+        )
     return 0

@@ -14,7 +14,7 @@ import pandas as pd
 from labstand.diagnosis_report import write_report
 from labstand.errors import CommandError, ExitCode
 from recordings import RecordingError, open_recording
-from sim.config import ConfigError, config_from_dict, load_config
+from sim.config import ConfigError, StandConfig, config_from_dict, load_config
 from sim.identify import Diagnosis, DiagnosisInputError, Trace, diagnose, make_trace
 
 
@@ -38,20 +38,30 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     )
     parser.add_argument("--params", default="final", help="nominal parameter set (final)")
     parser.add_argument(
-        "--mass-kg", type=float, help="weight mass, kg (default: each recording's stored weight)"
+        "--mass-kg",
+        type=float,
+        help="weight mass, kg (default: the --stand file's default weight, else each "
+        "recording's stored weight)",
     )
     parser.add_argument("--json", action="store_true", help="print the result as JSON")
     parser.add_argument("--report", type=Path, metavar="DIR", help="write an HTML report here")
     parser.set_defaults(func=run)
 
 
-def _mass_of(path: Path, stored: object, override: float | None, fallback: float) -> float:
+def _mass_of(
+    path: Path, stored: object, override: float | None, stand: StandConfig | None
+) -> tuple[float, str]:
+    """The weight mass for one recording and where it comes from (as ``params_for``)."""
     if override is not None:
-        return override
+        return override, "--mass-kg"
+    if stand is not None:
+        return stand.default_mass_kg, f"default weight of {stand.source}"
     try:
-        return config_from_dict(stored, str(path)).default_mass_kg  # type: ignore[arg-type]
+        mass = config_from_dict(stored, str(path)).default_mass_kg  # type: ignore[arg-type]
     except (ConfigError, TypeError):
-        return fallback
+        fallback = load_config(None).default_mass_kg
+        return fallback, "the paper stand's default weight (the stored stand is unreadable)"
+    return mass, "stored in the recording"
 
 
 def trace_of(name: str, frame: pd.DataFrame, mass_kg: float) -> Trace:
@@ -76,10 +86,13 @@ def run(args: argparse.Namespace) -> int:
     if args.mass_kg is not None and not args.mass_kg > 0:
         raise CommandError(f"mass must be > 0 kg, got {args.mass_kg:g} kg", ExitCode.USAGE)
     traces = []
+    masses: dict[str, dict[str, float | str]] = {}
     for path in args.recordings:
         try:
             rec = open_recording(path)
-            mass = _mass_of(path, rec.metadata.stand_config, args.mass_kg, config.default_mass_kg)
+            stand = config if args.stand is not None else None
+            mass, source = _mass_of(path, rec.metadata.stand_config, args.mass_kg, stand)
+            masses[str(path)] = {"kg": mass, "source": source}
             traces.append(trace_of(path.name, rec.frame(), mass))
         except (RecordingError, DiagnosisInputError) as err:
             raise CommandError(str(err), ExitCode.USAGE) from None
@@ -95,11 +108,14 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         out = result.to_dict()
         out["recordings"] = [str(p) for p in args.recordings]
+        out["mass_kg"] = masses
         if index is not None:
             out["report"] = str(index)
         print(json.dumps(out, indent=2))
         return 0
     _print_summary(result, index)
+    for path, m in masses.items():
+        print(f"Mass: {Path(path).name} {m['kg']:g} kg ({m['source']})")
     return 0
 
 

@@ -15,9 +15,10 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Add ``labstand info``."""
     parser = sub.add_parser(
         "info",
-        help="duration, channels, rates, lost samples and metadata of a recording",
+        help="duration, channels, rates, lost samples, metadata and events of a recording",
         description="Summarise a recording (.mcap, .h5, or a .csv/.tdms run). JSON keys: "
-        "duration_s, lost_samples, channels (name -> {unit, rate_hz, samples}), metadata, ...",
+        "duration_s, lost_samples, channels (name -> {unit, rate_hz, samples}), metadata, "
+        "event_list ([{t_s, kind, text}]: why the run ended), ...",
     )
     parser.add_argument("recording", type=Path, metavar="REC")
     parser.add_argument("--json", action="store_true", help="print JSON")
@@ -56,3 +57,25 @@ def _print(info: dict[str, Any]) -> None:
         print(f"    {name:<22} {ch['unit'] or '-':<5} {rate:>10} {ch['samples']:>9} samples")
     for line in info["repairs"]:
         print(f"  repaired: {line}")
+    _print_events(info["event_list"])
+
+
+#: Events listed by the text output; ``labstand cat REC --events`` prints them all.
+SHOWN_EVENTS = 20
+#: Kinds that end a run.
+ENDINGS = ("stop", "estop", "fault")
+
+
+def _print_events(events: list[dict[str, Any]]) -> None:
+    if not events:
+        print("  events: none")
+        return
+    print(f"  events ({len(events)}):")
+    shown = events if len(events) <= SHOWN_EVENTS else events[: SHOWN_EVENTS - 1]
+    for e in shown:
+        print(f"    {e['t_s']:12.6f} s  {e['kind']:<7} {' '.join(e['text'].split())}")
+    if len(shown) < len(events):
+        print(f"    … {len(events) - len(shown)} more (labstand cat REC --events)")
+    ending = next((e for e in reversed(events) if e["kind"] in ENDINGS), None)
+    if ending is not None:
+        print(f"  ended: {ending['kind']} at {ending['t_s']:.6f} s: {ending['text']}")

@@ -8,7 +8,7 @@ from collections.abc import Mapping
 from pathlib import Path
 
 from labstand.plots import plot_replay
-from labstand.recording_stand import params_for
+from labstand.recording_stand import mass_source, params_for
 from recordings import open_recording
 from recordings.replay import replay
 from sim.metrics import ChannelMetrics
@@ -35,7 +35,12 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
         metavar="FILE",
         help="stand file (default: the one stored in the recording)",
     )
-    parser.add_argument("--mass-kg", type=float, help="weight mass, kg (default: the recording's)")
+    parser.add_argument(
+        "--mass-kg",
+        type=float,
+        help="weight mass, kg (default: the --stand file's default weight, else the one "
+        "stored in the recording)",
+    )
     parser.add_argument("--json", action="store_true", help="print JSON (channels.u.R, ...)")
     parser.add_argument("--plot", type=Path, metavar="PNG", help="recorded vs simulated + residual")
     parser.set_defaults(func=run)
@@ -50,6 +55,7 @@ def run(args: argparse.Namespace) -> int:
         "recording": str(args.recording),
         "params": name,
         "mass_kg": params.mass_kg,
+        "mass_source": mass_source(recording, args.stand, args.mass_kg),
         **result.to_dict(),
     }
     if args.plot is not None:
@@ -63,7 +69,10 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps(out, indent=2))
         return 0
-    print(f"Replay of {args.recording} with parameters '{name}', m = {params.mass_kg:g} kg:")
+    print(
+        f"Replay of {args.recording} with parameters '{name}', "
+        f"m = {params.mass_kg:g} kg ({out['mass_source']}):"
+    )
     print_metrics(result.metrics)
     for note in result.notes:
         print(f"  note: {note}")

@@ -25,7 +25,7 @@ from types import FrameType
 from typing import Any
 
 from drivers.signals import SignalSpec, plan_motion
-from labstand.commands.common import add_stand_options, load_stand
+from labstand.commands.common import add_stand_options, config_with_mass, load_stand
 from labstand.commands.simulate import add_signal_options, signal_from_args
 from labstand.display import make_display
 from labstand.errors import CommandError, ExitCode
@@ -42,7 +42,7 @@ from labstand.session_record import RecordingPipe
 from labstand.session_safety import EStopError, SafetyLimits
 from recordings.base import FORMATS, open_writer
 from recordings.schema import Effect, RecordingMetadata, make_metadata
-from sim.config import StandConfig, config_from_dict
+from sim.config import StandConfig
 from sim.effects import EffectSpec, parse_effects
 
 
@@ -95,21 +95,6 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     # for tests: faults injected by the simulated stand (sim/hardware/faults.py)
     parser.add_argument("--sim-fault", action="append", default=[], help=argparse.SUPPRESS)
     parser.set_defaults(func=run)
-
-
-def config_with_mass(config: StandConfig, mass_kg: float) -> dict[str, Any]:
-    """The stand configuration whose default weight is the mass on the stand."""
-    raw = config.to_dict()
-    weights = raw["weights_kg"]
-    name = next((n for n, m in weights.items() if m == mass_kg), None)
-    if name is None:
-        name = next(
-            f"run{i or ''}" for i in range(len(weights) + 1) if f"run{i or ''}" not in weights
-        )
-        weights[name] = mass_kg
-    raw["weight"]["default"] = name
-    config_from_dict(raw, config.source)  # still valid
-    return raw
 
 
 def _title(args: argparse.Namespace, spec: SignalSpec, mass_kg: float) -> str:

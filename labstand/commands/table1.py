@@ -7,7 +7,7 @@ import json
 from pathlib import Path
 from typing import Any
 
-from labstand.recording_stand import params_for
+from labstand.recording_stand import mass_source, params_for
 from recordings import open_recording
 from recordings.replay import replay
 
@@ -24,6 +24,12 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     parser.add_argument("--first", default="starting", help="first parameter set (starting)")
     parser.add_argument("--second", default="final", help="second parameter set (final)")
     parser.add_argument("--stand", type=Path, metavar="FILE", help="stand file")
+    parser.add_argument(
+        "--mass-kg",
+        type=float,
+        help="weight mass, kg (default: the --stand file's default weight, else each "
+        "recording's stored weight)",
+    )
     parser.add_argument("--json", action="store_true", help="print JSON rows (default: Markdown)")
     parser.set_defaults(func=run)
 
@@ -37,8 +43,10 @@ def run(args: argparse.Namespace) -> int:
         signal = recording.metadata.signal or {}
         row["signal"] = signal.get("shape", "")
         row["frequency_hz"] = signal.get("frequency_hz")
+        row["mass_source"] = mass_source(recording, args.stand, args.mass_kg)
         for label, name in (("first", args.first), ("second", args.second)):
-            params, _ = params_for(recording, args.stand, name, None)
+            params, _ = params_for(recording, args.stand, name, args.mass_kg)
+            row["mass_kg"] = params.mass_kg
             metrics = replay(recording.frame(), params).metrics
             row[label] = {
                 "params": name,
@@ -52,7 +60,7 @@ def run(args: argparse.Namespace) -> int:
         print(json.dumps(rows, indent=2))
         return 0
     head = (
-        f"| recording | signal | f [Hz] | R(u) {args.first} | R(u) {args.second} | "
+        f"| recording | signal | f [Hz] | m [kg] | R(u) {args.first} | R(u) {args.second} | "
         f"R(F) {args.first} | R(F) {args.second} | NRMSE(u) {args.second} | "
         f"NRMSE(F) {args.second} |"
     )
@@ -62,8 +70,11 @@ def run(args: argparse.Namespace) -> int:
         f, s = r["first"], r["second"]
         freq = "" if r["frequency_hz"] is None else f"{r['frequency_hz']:g}"
         print(
-            f"| {Path(r['recording']).name} | {r['signal']} | {freq} | {f['R_u']:.6f} | "
+            f"| {Path(r['recording']).name} | {r['signal']} | {freq} | {r['mass_kg']:g} | "
+            f"{f['R_u']:.6f} | "
             f"{s['R_u']:.6f} | {f['R_F_dyn']:.5f} | {s['R_F_dyn']:.5f} | {s['nrmse_u']:.4f} | "
             f"{s['nrmse_F']:.4f} |"
         )
+    sources = sorted({r["mass_source"] for r in rows})
+    print(f"\nMass: {'; '.join(sources)}.")
     return 0

@@ -116,6 +116,7 @@ def test_diagnose_command_on_csv_recordings_with_report(
     assert main(["diagnose", *paths, "--mass-kg", "8.131", "--json", "--report", str(report)]) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["effect"] == "dial_gauge_calibration"
+    assert out["mass_kg"][paths[0]] == {"kg": 8.131, "source": "--mass-kg"}
     assert {"effect", "ranking", "where", "gap_before", "gap_after"} <= set(out)
     assert set(out["gap_before"]["u"]) == {"R", "psi", "nrmse"}
     assert all({"effect", "score", "params"} <= set(r) for r in out["ranking"])

@@ -41,8 +41,8 @@ def test_recover_an_intact_file_and_refuse_overwriting(simulated_mcap: Path, tmp
     )
     assert main(["convert", str(simulated_mcap), str(simulated_mcap)]) == 2
     assert "would overwrite the source" in capsys.readouterr().err
-    assert main(["convert", str(simulated_mcap), str(tmp_path / "x.parquet")]) == 2
-    assert "cannot write '.parquet'" in capsys.readouterr().err
+    assert main(["convert", str(simulated_mcap), str(tmp_path / "x.xlsx")]) == 2
+    assert "cannot write '.xlsx'" in capsys.readouterr().err
     assert not list(tmp_path.glob("*.part*"))  # nothing half-written left behind
 
 

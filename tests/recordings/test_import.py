@@ -103,7 +103,9 @@ def test_csv_mapping_errors(tmp_path: Path):
     src.write_text("t_s,x_mm,u_mm,F_N\n0,1,2,3\n0.0005,1,oops,3\n", encoding="utf-8")
     with pytest.raises(ImportMappingError) as info:
         read_csv(src)
-    assert str(info.value) == f"{src}: column 'u_mm' line 3: not a finite number: 'oops'"
+    assert str(info.value) == (
+        f"{src}: line 3: '0.0005,1,oops,3': column 'u_mm': 'oops' is not a finite number"
+    )
 
 
 def test_cli_import_errors_are_one_line(tmp_path: Path, capsys):

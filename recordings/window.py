@@ -1,0 +1,249 @@
+"""A time window of a recording, read without reading the whole file where the format allows.
+
+* MCAP: the ``mcap`` package's seeking reader and the file's chunk index: only the chunks
+  whose messages fall in the window (plus the batch that starts before it) are
+  decompressed.
+* HDF5: the start and end rows are found by bisection on ``t_ns`` (a few chunk reads),
+  then only that slice is read.
+* Anything else (CSV, TDMS, Parquet), and any file the fast paths cannot read (a truncated
+  MCAP without its summary, ...): read whole with ``open_recording``, then cut, so the
+  errors are the ordinary reader's.
+
+Times are seconds since the start of the run (the frame's ``t_s``); the window includes
+both ends. The window's streams keep their original times (nothing is shifted).
+"""
+
+from __future__ import annotations
+
+import bisect
+import logging
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from recordings.base import EVENTS_DTYPE
+from recordings.errors import RecordingError
+from recordings.recording import Recording, open_recording
+from recordings.schema import COMMAND_DTYPE, DRIVE_DTYPE, GAUGES_DTYPE, RecordingMetadata
+
+__all__ = ["Window", "WindowError", "cut", "read_window"]
+
+log = logging.getLogger(__name__)
+
+
+class WindowError(RecordingError):
+    """A window that is not inside the recording, or ends before it starts."""
+
+
+@dataclass(frozen=True)
+class Window:
+    """A window ``[start_s, end_s]`` of a recording whose gauges span ``[first_s, last_s]``."""
+
+    recording: Recording
+    start_s: float
+    end_s: float
+    first_s: float
+    last_s: float
+
+
+def _check(where: str, start_s: float | None, end_s: float | None, span: tuple[int, int]) -> None:
+    first, last = span[0] / 1e9, span[1] / 1e9
+    inside = f"the recording spans {first:.6g} … {last:.6g} s"
+    for option, value in (("--start", start_s), ("--end", end_s)):
+        if value is not None and not (np.isfinite(value) and first <= value <= last):
+            raise WindowError(f"{where}: {option} {value:g} s is outside; {inside}")
+    if start_s is not None and end_s is not None and not start_s < end_s:
+        raise WindowError(f"{where}: --start {start_s:g} s must be before --end {end_s:g} s")
+
+
+def _bounds(start_s: float | None, end_s: float | None, span: tuple[int, int]) -> tuple[int, int]:
+    lo = span[0] if start_s is None else round(start_s * 1e9)
+    hi = span[1] if end_s is None else round(end_s * 1e9)
+    return lo, hi
+
+
+def _slice(block: NDArray[np.void], lo: int, hi: int) -> NDArray[np.void]:
+    t = block["t_ns"]
+    return block[int(np.searchsorted(t, lo, "left")) : int(np.searchsorted(t, hi, "right"))]
+
+
+def cut(recording: Recording, lo_ns: int, hi_ns: int) -> Recording:
+    """The part of ``recording`` with ``lo_ns ≤ t_ns ≤ hi_ns``, in every stream."""
+    return Recording(
+        path=recording.path,
+        metadata=recording.metadata,
+        gauges=_slice(recording.gauges, lo_ns, hi_ns),
+        command=_slice(recording.command, lo_ns, hi_ns),
+        drive=_slice(recording.drive, lo_ns, hi_ns),
+        events_array=_slice(recording.events_array, lo_ns, hi_ns),
+        repairs=list(recording.repairs),
+    )
+
+
+def _whole(path: Path, start_s: float | None, end_s: float | None) -> Window:
+    full = open_recording(path)
+    span = (int(full.gauges["t_ns"][0]), int(full.gauges["t_ns"][-1]))
+    _check(str(path), start_s, end_s, span)
+    lo, hi = _bounds(start_s, end_s, span)
+    return Window(cut(full, lo, hi), lo / 1e9, hi / 1e9, span[0] / 1e9, span[1] / 1e9)
+
+
+class _FallbackError(Exception):
+    """The fast path cannot read this file; read it whole instead."""
+
+
+def read_window(
+    path: str | Path, start_s: float | None = None, end_s: float | None = None
+) -> Window:
+    """The window ``[start_s, end_s]`` (s since the start of the run; None: to the edge).
+
+    Raises
+    ------
+    RecordingError
+        A bound outside the recording, ``start_s ≥ end_s``, or what ``open_recording``
+        raises for the file.
+    """
+    p = Path(path)
+    suffix = p.suffix.lower()
+    try:
+        if suffix == ".mcap":
+            return _mcap_window(p, start_s, end_s)
+        if suffix in {".h5", ".hdf5"}:
+            return _hdf5_window(p, start_s, end_s)
+    except _FallbackError as why:
+        log.debug("%s: reading it whole (%s)", p, why)
+    return _whole(p, start_s, end_s)
+
+
+def _finish(
+    path: Path,
+    meta: RecordingMetadata,
+    streams: dict[str, NDArray[np.void]],
+    bounds: tuple[int, int],
+    span: tuple[int, int],
+) -> Window:
+    rec = Recording(
+        path=path,
+        metadata=meta,
+        gauges=streams["gauges"],
+        command=streams["command"],
+        drive=streams["drive"],
+        events_array=streams["events"],
+    )
+    rec.check()
+    return Window(rec, bounds[0] / 1e9, bounds[1] / 1e9, span[0] / 1e9, span[1] / 1e9)
+
+
+def _mcap_window(path: Path, start_s: float | None, end_s: float | None) -> Window:
+    from mcap.exceptions import McapError
+    from mcap.reader import make_reader
+
+    from recordings.mcap_writer import COMMAND_CODEC, DRIVE_CODEC, GAUGE_CODEC, METADATA_NAME
+    from recordings.proto import EVENT, parse
+
+    where = str(path)
+    try:
+        with path.open("rb") as f:
+            reader = make_reader(f)
+            if reader.get_summary() is None:
+                raise _FallbackError("no summary section")
+            meta_json = next(
+                (m.metadata.get("json") for m in reader.iter_metadata() if m.name == METADATA_NAME),
+                None,
+            )
+            if meta_json is None:
+                raise _FallbackError("no labstand metadata record")
+            meta = RecordingMetadata.from_json(meta_json, where)
+            t0 = meta.start_time_ns
+
+            def batches(topic: str, lo: int, hi: int) -> list[bytes]:
+                found = reader.iter_messages(topics=[topic], starting_at=t0 + lo, ending_at=t0 + hi)
+                return [m.data for _, _, m in found]
+
+            def edge(reverse: bool) -> NDArray[np.void]:
+                first = next(reader.iter_messages(topics=["/gauges"], reverse=reverse), None)
+                return GAUGE_CODEC.decode_many([first[2].data] if first else [], where)
+
+            head, tail = edge(reverse=False), edge(reverse=True)
+            if not len(head):
+                raise _FallbackError("no gauge samples")
+            span = (int(head["t_ns"][0]), int(tail["t_ns"][-1]))
+            _check(where, start_s, end_s, span)
+            lo, hi = _bounds(start_s, end_s, span)
+            streams: dict[str, Any] = {}
+            for name, topic, codec in (
+                ("gauges", "/gauges", GAUGE_CODEC),
+                ("command", "/command", COMMAND_CODEC),
+            ):
+                # the batch that starts before the window holds its first samples
+                before = next(
+                    reader.iter_messages(topics=[topic], ending_before=t0 + lo, reverse=True), None
+                )
+                data = ([before[2].data] if before else []) + batches(topic, lo, hi)
+                streams[name] = _slice(codec.decode_many(data, where), lo, hi)
+            drive = DRIVE_CODEC.decode_fast(batches("/drive", lo, hi))
+            if drive is None:
+                raise _FallbackError("drive polls not in the fixed layout")
+            streams["drive"] = _slice(_as(drive, DRIVE_DTYPE), lo, hi)
+            events = [parse(EVENT, d, where) for d in batches("/events", lo, hi)]
+            streams["events"] = np.array(
+                [(e.t_ns, e.kind, e.text) for e in events], dtype=EVENTS_DTYPE
+            ).reshape(len(events))
+    except WindowError:
+        raise
+    except (McapError, EOFError, ValueError, KeyError) as err:
+        raise _FallbackError(f"{type(err).__name__}: {err}") from err
+    return _finish(path, meta, streams, (lo, hi), span)
+
+
+def _as(fields: Any, dtype: np.dtype[Any]) -> NDArray[np.void]:
+    names = dtype.names or ()
+    out = np.empty(len(fields[names[0]]), dtype=dtype)
+    for name in names:
+        out[name] = fields[name]
+    return out
+
+
+def _hdf5_window(path: Path, start_s: float | None, end_s: float | None) -> Window:
+    import h5py
+
+    where = str(path)
+    try:
+        with h5py.File(path, "r") as h5:
+            meta = RecordingMetadata.from_json(h5.attrs["metadata_json"], where)
+            g = h5["gauges"]
+            if len(g) == 0:
+                raise _FallbackError("no gauge samples")
+            span = (int(g[0]["t_ns"]), int(g[-1]["t_ns"]))
+            _check(where, start_s, end_s, span)
+            lo, hi = _bounds(start_s, end_s, span)
+            streams: dict[str, Any] = {}
+            for name, dtype in (
+                ("gauges", GAUGES_DTYPE),
+                ("command", COMMAND_DTYPE),
+                ("drive", DRIVE_DTYPE),
+            ):
+                ds = h5[name]
+                rows = range(len(ds))
+
+                def t_at(i: int, ds: Any = ds) -> int:
+                    return int(ds[i]["t_ns"])
+
+                a = bisect.bisect_left(rows, lo, key=t_at)
+                b = bisect.bisect_right(rows, hi, key=t_at)
+                part = np.asarray(ds[a:b]) if b > a else np.empty(0, ds.dtype)
+                streams[name] = _as(part, dtype)
+            e = h5["events"][...]
+            events = np.empty(len(e), dtype=EVENTS_DTYPE)
+            events["t_ns"] = e["t_ns"]
+            for key in ("kind", "text"):
+                events[key] = [v.decode() if isinstance(v, bytes) else str(v) for v in e[key]]
+            streams["events"] = _slice(events, lo, hi)
+    except WindowError:
+        raise
+    except (OSError, KeyError, ValueError, TypeError) as err:
+        raise _FallbackError(f"{type(err).__name__}: {err}") from err
+    return _finish(path, meta, streams, (lo, hi), span)
