@@ -152,7 +152,10 @@ class DriveInterface(_Device):
 
     The drive trips by itself unless ``poll()`` (or ``kick_watchdog()``) is called at
     least every 0.5 s once ``enable()`` armed the watchdog, so a dead controller stops
-    the stand.
+    the stand. A controller that ends in order calls ``stand_down()`` (``close()`` does):
+    the drive is disabled, then the watchdog is released, and the drive stays healthy for
+    the next run. A trip is left only by a real fault: the drive's own, or a controller
+    that died or lost the link.
     """
 
     name: str = "drive"
@@ -177,6 +180,17 @@ class DriveInterface(_Device):
         """Disable the drive at once (the motor coasts): the emergency stop."""
         self._check_open()
         self._disable()
+
+    def stand_down(self) -> None:
+        """Disable the drive, then release its watchdog: it stays disabled and healthy.
+
+        The end of every orderly run (and ``close()``). A later ``enable()`` arms the
+        watchdog again. A tripped drive stays tripped (``reset_trip`` clears it).
+        """
+        self._check_open()
+        self._disable()
+        self._stand_down()
+        log.info("%s: disabled, watchdog stood down", self.name)
 
     def load_profile(self, spec: SignalSpec) -> DriveProfile:
         """Plan a motion within the limits and load it into the drive (nothing moves).
@@ -229,6 +243,8 @@ class DriveInterface(_Device):
     def _reset_trip(self) -> None: ...
     @abstractmethod
     def _kick_watchdog(self) -> None: ...
+    @abstractmethod
+    def _stand_down(self) -> None: ...
 
 
 @dataclass(frozen=True)

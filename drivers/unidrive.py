@@ -21,6 +21,11 @@ pymodbus returns error replies instead of raising them; they become exceptions h
           ├── DriveProfileError (+ValueError)          the drive program refused a profile
           └── DriveClosedError (+ClosedError)          used after close()
 
+The control word, and with it the watchdog of bit 14, counts only while Pr 6.43 = 1
+(HARDWARE.md): ``enable`` sets it, ``stand_down`` (the end of an orderly run, and
+``close``) writes the disabled word, then Pr 6.43 = 0, so the drive stays disabled and
+healthy instead of tripping on the watchdog once polls stop.
+
 ``LimitError`` (drivers.limits) is raised before anything is written when a profile
 breaks labstand's limits.
 """
@@ -244,6 +249,12 @@ class UnidriveSP(DriveInterface):
         self._write_control((self._cw & ControlBit.WATCHDOG.mask) | ControlBit.AUTO.mask)
         log.info("%s: disabled", self.name)
 
+    def _stand_down(self) -> None:
+        # after _disable: the word is 128 (AUTO, output off); clearing Pr 6.43 takes the
+        # control word out of force, its watchdog with it [HARDWARE.md: the word is active
+        # only with Pr 6.43 = 1; that the real drive then forgets bit 14 is unconfirmed]
+        self.write_raw([pr.CONTROL_WORD_ENABLE], [0])
+
     def check_drive_limits(self) -> DriveLimits:
         """The drive's commissioned limits; LimitError if labstand's exceed them."""
         amp, speed, accel = (
@@ -306,8 +317,9 @@ class UnidriveSP(DriveInterface):
     def _close(self) -> None:
         try:
             self._disable()
+            self._stand_down()
         except DriveError as err:
-            log.warning("%s: could not disable on close: %s", self.name, err)
+            log.warning("%s: could not disable (and stand down) on close: %s", self.name, err)
         finally:
             self._client.close()
 

@@ -231,6 +231,32 @@ def test_close_disables_and_refuses_work(drive: UnidriveSP, sim: SimulatedDrive)
     drive.close()  # idempotent
 
 
+def test_stand_down_leaves_the_drive_disabled_and_healthy(
+    drive: UnidriveSP, sim: SimulatedDrive
+) -> None:
+    drive.enable()
+    run_for(sim, drive, 1.0)
+    drive.stand_down()
+    sim.advance(round(3 * RATE))  # no polls: a watchdog left armed would trip at 1 s
+    state = drive.poll()
+    assert state.healthy and not state.active and not state.tripped
+    assert sim.params[pr.CONTROL_WORD_ENABLE] == 0
+    drive.stand_down()  # idempotent
+    drive.enable()  # the next run enables and arms again
+    run_for(sim, drive, 1.0)
+    assert drive.poll().active
+    sim.advance(round(1.5 * RATE))
+    assert drive.poll().trip_code == TripCode.WATCHDOG
+
+
+def test_close_stands_the_watchdog_down(drive: UnidriveSP, sim: SimulatedDrive) -> None:
+    drive.enable()
+    run_for(sim, drive, 0.5)
+    drive.close()
+    sim.advance(round(3 * RATE))
+    assert sim.trip_code == 0 and not sim.enabled
+
+
 def test_exception_tree() -> None:
     for cls, builtin in (
         (DriveTimeoutError, TimeoutError),

@@ -1,0 +1,120 @@
+"""Run after run at a stand that stays up: an orderly end leaves the drive healthy.
+
+One ``labstand stand-sim`` process plays the stand that is always on (Modbus TCP on
+127.0.0.1, the gauges on a raw pty); a stand file's ``[devices]`` table points
+``labstand run --backend stand --yes`` at it. Between runs an independent Modbus client
+(plain pymodbus, not labstand's driver; reads only, so it toggles no watchdog) waits
+until more than the watchdog's second of drive time has passed without labstand, then
+reads Pr 10.20: a drive left to its watchdog would have tripped (trip 30) by then.
+"""
+
+from __future__ import annotations
+
+import threading
+from collections.abc import Callable, Iterator
+from pathlib import Path
+
+import pytest
+from pymodbus.client import ModbusTcpClient
+
+from drivers import unidrive_registers as pr
+from labstand.errors import ExitCode
+from sim.hardware.process import StandProcess
+from tests.run.conftest import Outcome, wait_for
+
+#: A short run: 0.1 s rest, one 10 mm trapezoid at 2 Hz, 0.1 s rest (0.7 s of motion).
+BRIEF = [
+    "--backend", "stand", "--yes", "--signal", "trapezoidal", "--amplitude-mm", "10",
+    "--frequency-hz", "2", "--cycles", "1", "--dwell-start-s", "0.1", "--dwell-end-s", "0.1",
+]  # fmt: skip
+#: The drive's watchdog trips 1 s after the last edge; wait this much drive time.
+QUIET_S = 1.2
+
+
+class Observer:
+    """Reads the simulated drive over Modbus TCP like any other client would."""
+
+    def __init__(self, port: int) -> None:
+        self.client = ModbusTcpClient("127.0.0.1", port=port, timeout=1.0)
+        assert self.client.connect()
+
+    def read(self, reg: pr.Register) -> int:
+        reply = self.client.read_holding_registers(reg.address, count=reg.count, device_id=1)
+        assert not reply.isError(), reply
+        words = reply.registers
+        return words[0] if reg.count == 1 else (words[0] << 16) | words[1]
+
+    def trip_after_quiet(self) -> int:
+        """Pr 10.20 once QUIET_S of drive time has passed (read on the drive's own clock)."""
+        start_ms = self.read(pr.DRIVE_CLOCK)
+        wait_for(
+            lambda: self.read(pr.DRIVE_CLOCK) - start_ms > QUIET_S * 1e3,
+            10.0,
+            f"{QUIET_S:g} s of drive time",
+        )
+        return self.read(pr.TRIP_CODE)
+
+    def write(self, reg: pr.Register, value: int) -> None:
+        reply = self.client.write_register(reg.address, value, device_id=1)
+        assert not reply.isError(), reply
+
+
+@pytest.fixture
+def standing_stand(tmp_path: Path) -> Iterator[tuple[Path, Observer]]:
+    """A simulated stand that stays up, and a stand file whose [devices] name it."""
+    with StandProcess() as sim:
+        ep = sim.endpoints
+        stand = tmp_path / "stand.toml"
+        stand.write_text(f'[devices]\ndrive = "{ep["modbus"]}"\ngauges = "{ep["gauges"]}"\n')
+        observer = Observer(int(ep["modbus"].rsplit(":", 1)[1]))
+        try:
+            yield stand, observer
+        finally:
+            observer.client.close()
+    assert sim.stopped.get("event") == "stopped"
+
+
+def test_ten_runs_then_a_fault_a_refusal_and_a_reset(
+    labstand: Callable[..., Outcome],
+    standing_stand: tuple[Path, Observer],
+    tmp_path: Path,
+) -> None:
+    stand, drive = standing_stand
+
+    def run(name: str, *extra: str) -> Outcome:
+        return labstand("run", *BRIEF, "--stand", stand, *extra, "-o", tmp_path / name)
+
+    for i in range(10):
+        result = run(f"run{i}.mcap")
+        assert result.code == 0, f"run {i + 1}: {result.err}"
+        assert "Done: drive disabled;" in result.out
+        assert drive.trip_after_quiet() == 0, f"the drive tripped after run {i + 1}"
+        assert drive.read(pr.STATUS_WORD) & pr.StatusBit.HEALTHY.mask
+
+    # a real fault: the drive trips on its own (a user trip written by another client)
+    out = tmp_path / "fault.mcap"
+
+    def trip_when_recording() -> None:
+        wait_for(out.exists, 30.0, "the faulted run to record")
+        drive.write(pr.USER_TRIP, 45)
+
+    tripper = threading.Thread(target=trip_when_recording, name="test tripper")
+    tripper.start()
+    try:
+        result = run("fault.mcap")
+    finally:
+        tripper.join(35.0)
+    assert result.code == ExitCode.ESTOP, result.err
+    assert result.last_error_line.startswith("labstand: e-stop: the drive tripped: trip 45;")
+    assert drive.trip_after_quiet() == 45  # labstand left the drive's own trip alone
+
+    result = run("refused.mcap")
+    assert result.code == ExitCode.REFUSED, result.err
+    assert result.last_error_line.endswith(
+        "is tripped: trip 45; find the cause, then run again with --reset-trip"
+    )
+    assert not (tmp_path / "refused.mcap").exists()
+
+    result = run("reset.mcap", "--reset-trip")
+    assert result.code == 0, result.err
+    assert drive.trip_after_quiet() == 0
