@@ -20,8 +20,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from drivers.closing import ClosesOnExit
-from drivers.errors import ClosedError
-from drivers.limits import DriveLimits
+from drivers.errors import ClosedError, DriveNotReadyError
+from drivers.limits import DriveLimits, LimitError
 from drivers.signals import DriveProfile, SignalSpec
 from drivers.unidrive_profile import ProfileState
 from drivers.unidrive_registers import StatusBit, TripCode
@@ -160,11 +160,34 @@ class DriveInterface(_Device):
 
     name: str = "drive"
     kind: str = "driver"
+    _limits_checked: bool = False
 
     @property
     @abstractmethod
     def limits(self) -> DriveLimits:
         """The limits profiles are planned and checked against."""
+
+    def check_limits(self) -> DriveLimits:
+        """The drive's own commissioned limits; LimitError if labstand's are looser.
+
+        Part of every pre-flight: ``enable()`` is refused on a connection where this has
+        not passed, so nothing moves under limits nobody compared with the drive's.
+        """
+        self._check_open()
+        theirs = self._read_limits()
+        mine = self.limits
+        for what, own, drive, unit in (
+            ("amplitude", mine.amplitude_max_m, theirs.amplitude_max_m, "m"),
+            ("speed", mine.speed_max_m_s, theirs.speed_max_m_s, "m/s"),
+            ("acceleration", mine.accel_max_m_s2, theirs.accel_max_m_s2, "m/s²"),
+        ):
+            if own > drive * (1 + 1e-6):
+                raise LimitError(
+                    f"{self.name}: labstand's {what} limit {own:g} {unit} exceeds the "
+                    f"drive's commissioned {drive:g} {unit}"
+                )
+        self._limits_checked = True
+        return theirs
 
     def poll(self) -> DriveState:
         """Read position, velocity, profile state, status and trip; toggles the watchdog."""
@@ -172,8 +195,19 @@ class DriveInterface(_Device):
         return self._poll()
 
     def enable(self) -> None:
-        """Enable the drive (control word ENABLE + AUTO); arms the watchdog."""
+        """Enable the drive (control word ENABLE + AUTO); arms the watchdog.
+
+        Raises
+        ------
+        DriveNotReadyError
+            ``check_limits()`` has not passed on this connection (nothing written).
+        """
         self._check_open()
+        if not self._limits_checked:
+            raise DriveNotReadyError(
+                f"{self.name}: enable refused: the drive's limits were not checked "
+                "(pre-flight: check_limits())"
+            )
         self._enable()
 
     def disable(self) -> None:
@@ -225,6 +259,8 @@ class DriveInterface(_Device):
         self._check_open()
         self._kick_watchdog()
 
+    @abstractmethod
+    def _read_limits(self) -> DriveLimits: ...
     @abstractmethod
     def _poll(self) -> DriveState: ...
     @abstractmethod

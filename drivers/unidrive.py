@@ -43,7 +43,7 @@ from pymodbus.pdu import ModbusPDU
 
 from drivers import unidrive_registers as pr
 from drivers.interfaces import DriveInterface, DriveState
-from drivers.limits import DriveLimits, LimitError
+from drivers.limits import DriveLimits
 from drivers.signals import DriveProfile, SignalSpec, plan_motion
 from drivers.unidrive_profile import (
     ProfileState,
@@ -103,7 +103,7 @@ class UnidriveSP(DriveInterface):
         fake); the driver closes it. Build real ones with ``open_unidrive``.
     limits
         Labstand's limits; profiles are planned against them and refused before anything
-        moves. ``check_drive_limits()`` compares them with the drive's own.
+        moves. ``check_limits()`` compares them with the drive's own (before ``enable``).
     device_id
         Modbus unit id (Pr 11.23 for RTU).
     retries
@@ -255,25 +255,13 @@ class UnidriveSP(DriveInterface):
         # only with Pr 6.43 = 1; that the real drive then forgets bit 14 is unconfirmed]
         self.write_raw([pr.CONTROL_WORD_ENABLE], [0])
 
-    def check_drive_limits(self) -> DriveLimits:
-        """The drive's commissioned limits; LimitError if labstand's exceed them."""
+    def _read_limits(self) -> DriveLimits:
+        """The limits commissioned on the drive (Pr 20.28–20.30)."""
         amp, speed, accel = (
             reg.to_value(raw)
             for reg, raw in zip(pr.LIMIT_BLOCK, self.read_raw(pr.LIMIT_BLOCK), strict=True)
         )
-        drive = DriveLimits(amp, speed, accel)
-        mine = self._limits
-        for what, own, theirs, unit in (
-            ("amplitude", mine.amplitude_max_m, amp, "m"),
-            ("speed", mine.speed_max_m_s, speed, "m/s"),
-            ("acceleration", mine.accel_max_m_s2, accel, "m/s²"),
-        ):
-            if own > theirs * (1 + 1e-6):
-                raise LimitError(
-                    f"{self.name}: labstand's {what} limit {own:g} {unit} exceeds the "
-                    f"drive's commissioned {theirs:g} {unit}"
-                )
-        return drive
+        return DriveLimits(amp, speed, accel)
 
     def _load_profile(self, spec: SignalSpec) -> DriveProfile:
         plan_motion(spec, self._limits)  # refuse before anything is written

@@ -154,9 +154,7 @@ class Session(SessionLoop):
                 refused=True,
             )
         first = self._first_block()
-        check_limits = getattr(self.drive, "check_drive_limits", None)
-        if callable(check_limits):
-            self._ask(check_limits, "cannot report its limits")
+        self._ask(self.drive.check_limits, "cannot report its limits")
         try:
             profile = self.drive.load_profile(spec)
         except DriveError as err:
