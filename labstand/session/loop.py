@@ -23,9 +23,9 @@ from numpy.typing import NDArray
 from drivers.errors import ClosedError, DriveError, GaugeError
 from drivers.interfaces import DriveInterface, DriveState, GaugeSource, GaugeStats
 from drivers.signals import DriveProfile
-from labstand.display import Display, RunStatus
-from labstand.session_record import RecordingPipe, RunClock
-from labstand.session_safety import EStopError, SafetyLimits, SafetyMonitor
+from labstand.session.display import Display, RunStatus
+from labstand.session.record import RecordingPipe, RunClock
+from labstand.session.safety import EStopError, SafetyLimits, SafetyMonitor
 from recordings.schema import concat_blocks
 
 log = logging.getLogger(__name__)
