@@ -53,6 +53,15 @@ SAMPLE_DTYPE = np.dtype(
 )
 
 
+#: What a trip found at pre-flight means. An orderly end stands the watchdog down, so a
+#: watchdog trip means the controller died or lost the link while in control.
+_TRIP_CAUSES = {
+    int(TripCode.WATCHDOG): ": the controller stopped toggling it while in control — "
+    "a killed labstand or a lost link",
+    int(TripCode.OVER_TRAVEL): ": the axis ran beyond its stroke",
+}
+
+
 @dataclass(frozen=True)
 class DriveState:
     """One poll of the drive (SI units).
@@ -101,6 +110,14 @@ class DriveState:
     def tripped(self) -> bool:
         """The drive is tripped (trip_code names why)."""
         return self.trip_code != 0
+
+    @property
+    def trip_description(self) -> str:
+        """``trip 30 (watchdog: why)``, or ``trip 45`` for a code without a name."""
+        code, name = self.trip_code, self.trip_name
+        if name == f"trip {code}":
+            return name
+        return f"trip {code} ({name}{_TRIP_CAUSES.get(code, '')})"
 
     @property
     def trip_name(self) -> str:

@@ -1,34 +1,45 @@
-"""Builds the devices a session runs on: the stand's, or the simulated stand's.
+"""The devices a session runs on, opened by backend name from the ``BACKENDS`` registry.
 
-The only place that knows the backends apart. ``stand`` opens the drive and the gauge
-port named by the stand file's ``[devices]`` table. ``sim`` starts ``labstand stand-sim``
-as a child process (``StandProcess``: Modbus TCP on 127.0.0.1 and a pty, the same wire
-protocols as the stand), opens the same drivers on its endpoints, and stops it when the
-devices are closed. Either way the session gets a ``DriveInterface`` and a
-``GaugeSource``.
+A backend is one module with a factory ``open_NAME(request: DeviceRequest) -> Devices``
+and one line in ``BACKENDS`` (python-can's ``BACKENDS`` dict): the module is imported
+only when the backend is chosen, so this package never imports a concrete driver (an
+import-linter contract). ``stand`` opens the stand file's ``[devices]``
+(``labstand.backends.stand``); ``sim`` starts the simulated stand as a child process and
+opens the same drivers on its endpoints (``labstand.backends.sim``). Either way the
+session gets a ``DriveInterface`` and a ``GaugeSource``.
 """
 
 from __future__ import annotations
 
+import importlib
 import logging
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from drivers.errors import DriveError, GaugeError
-from drivers.gauge_stream import open_gauges
 from drivers.interfaces import DriveInterface, GaugeSource
-from drivers.unidrive import open_unidrive
 from labstand.errors import CommandError, ExitCode
 from recordings.schema import Backend
 from sim.config import StandConfig
-from sim.hardware.process import StandProcess, StandStartError
 
 log = logging.getLogger(__name__)
 
-__all__ = ["BACKENDS", "Devices", "default_backend", "open_devices"]
+__all__ = [
+    "BACKENDS",
+    "BackendFactory",
+    "DeviceRequest",
+    "Devices",
+    "backend_factory",
+    "default_backend",
+    "open_devices",
+]
 
-BACKENDS = ("stand", "sim")
+#: Backend name → (module, factory). A new backend: its module, and one line here.
+BACKENDS: dict[str, tuple[str, str]] = {
+    "stand": ("labstand.backends.stand", "open_stand"),
+    "sim": ("labstand.backends.sim", "open_sim"),
+}
 
 
 @dataclass
@@ -39,8 +50,9 @@ class Devices:
     ----------
     where
         Where the devices are, one line for the operator.
-    sim
-        The simulated stand's process (backend ``sim``), else None.
+    stopper
+        Stops what the backend started for the devices (the simulated stand's process)
+        and returns its last word; None when there is nothing to stop.
     sim_summary
         The simulated stand's last line after ``stop_sim`` (its drive's final state).
     """
@@ -49,19 +61,18 @@ class Devices:
     gauges: GaugeSource
     backend: Backend
     where: str
-    sim: StandProcess | None = None
+    stopper: Callable[[], dict[str, Any]] | None = None
     sim_summary: dict[str, Any] = field(default_factory=dict)
 
     def stop_sim(self) -> dict[str, Any]:
-        """Stop the simulated stand (if any); returns its final summary."""
-        if self.sim is not None and self.sim.process is not None:
-            self.sim.stop()
-            self.sim_summary = dict(self.sim.stopped)
-            self.sim = None
+        """Stop what the backend started (if anything); returns its final summary."""
+        if self.stopper is not None:
+            stopper, self.stopper = self.stopper, None
+            self.sim_summary = stopper()
         return self.sim_summary
 
     def close(self) -> None:
-        """Close both drivers (the drive disables on close), then stop the simulation."""
+        """Close both drivers (the drive disables on close), then stop the backend."""
         try:
             self.drive.close()
         finally:
@@ -71,9 +82,55 @@ class Devices:
                 self.stop_sim()
 
 
+@dataclass(frozen=True)
+class DeviceRequest:
+    """What a backend factory is asked for.
+
+    Attributes
+    ----------
+    config
+        The stand configuration (limits, calibration, ``[devices]``).
+    mass_kg
+        The weight on the stand, kg (the simulated stand simulates it).
+    stand_file
+        The stand file, passed on to a simulated stand.
+    effects
+        Effects a simulated stand switches on (``NAME[:param=value,...]``).
+    sim_args
+        Further ``labstand stand-sim`` options (tests: ``--fault``).
+    """
+
+    config: StandConfig
+    mass_kg: float
+    stand_file: Path | None = None
+    effects: tuple[str, ...] = ()
+    sim_args: tuple[str, ...] = ()
+
+
+#: Opens a backend's devices; raises CommandError (usage or failure) when it cannot.
+BackendFactory = Callable[[DeviceRequest], Devices]
+
+
 def default_backend(config: StandConfig) -> str:
     """``stand`` when the stand file says where the devices are, else ``sim``."""
     return "stand" if config.devices is not None else "sim"
+
+
+def backend_factory(backend: str) -> BackendFactory:
+    """The factory registered for ``backend`` (its module imported now).
+
+    Raises
+    ------
+    CommandError
+        An unknown backend name (usage).
+    """
+    try:
+        module, name = BACKENDS[backend]
+    except KeyError:
+        known = ", ".join(BACKENDS)
+        raise CommandError(f"unknown backend {backend!r}; one of {known}", ExitCode.USAGE) from None
+    factory: BackendFactory = getattr(importlib.import_module(module), name)
+    return factory
 
 
 def open_devices(
@@ -85,78 +142,13 @@ def open_devices(
     effects: tuple[str, ...] = (),
     sim_args: tuple[str, ...] = (),
 ) -> Devices:
-    """Open the devices of a backend.
-
-    Parameters
-    ----------
-    backend
-        ``stand`` or ``sim``.
-    config
-        The stand configuration (limits, calibration, ``[devices]``).
-    mass_kg
-        The weight on the stand, kg (the simulated stand simulates it).
-    stand_file
-        The stand file, passed on to the simulated stand.
-    effects
-        Effects the simulated stand switches on (``NAME[:param=value,...]``).
-    sim_args
-        Further ``labstand stand-sim`` options (tests: ``--fault``).
+    """Open the devices of a backend (``DeviceRequest`` describes the arguments).
 
     Raises
     ------
     CommandError
-        No ``[devices]`` for the stand (usage), or a device cannot be opened (failure).
+        An unknown backend, or one the stand cannot have (usage); a device that cannot
+        be opened (failure).
     """
-    if backend == "stand":
-        if config.devices is None:
-            raise CommandError(
-                f"{config.source}: no [devices] table, so no stand to run; add one "
-                "(docs/configuration.md) or use --backend sim",
-                ExitCode.USAGE,
-            )
-        if effects:
-            raise CommandError("--effect needs --backend sim", ExitCode.USAGE)
-        dev = config.devices
-        return _open(dev.drive, dev.gauges, config, Backend.STAND, dev.gauges_baudrate)
-    if backend != "sim":
-        raise CommandError(f"unknown backend {backend!r}; one of {', '.join(BACKENDS)}")
-    args = ["--mass-kg", repr(mass_kg)]
-    if stand_file is not None:
-        args += ["--stand", str(stand_file)]
-    for text in effects:
-        args += ["--effect", text]
-    sim = StandProcess([*args, *sim_args])
-    try:
-        ep = sim.start()
-    except StandStartError as err:
-        raise CommandError(str(err)) from None
-    try:
-        devices = _open(ep["modbus"], ep["gauges"], config, Backend.SIM)
-    except BaseException:
-        sim.stop()
-        raise
-    devices.sim = sim
-    devices.where = f"simulated stand (pid {ep['pid']}): {devices.where}"
-    return devices
-
-
-def _open(
-    drive_url: str,
-    gauge_port: str,
-    config: StandConfig,
-    backend: Backend,
-    baudrate: int = 921_600,
-) -> Devices:
-    try:
-        drive = open_unidrive(drive_url, config.drive)
-    except DriveError as err:
-        raise CommandError(f"cannot reach the drive: {err}") from err
-    try:
-        gauges = open_gauges(
-            gauge_port, config.gauges, rate_hz=config.sample_rate_hz, baudrate=baudrate
-        )
-    except GaugeError as err:
-        drive.close()
-        raise CommandError(f"cannot open the gauges: {err}") from err
-    where = f"drive {drive_url}, gauges {gauge_port}"
-    return Devices(drive, gauges, backend, where)
+    request = DeviceRequest(config, mass_kg, stand_file, tuple(effects), tuple(sim_args))
+    return backend_factory(backend)(request)

@@ -32,7 +32,6 @@ from drivers.errors import DriveError, GaugeError
 from drivers.interfaces import DriveState, GaugeStats
 from drivers.signals import DriveProfile, SignalSpec
 from drivers.unidrive_profile import ProfileState
-from drivers.unidrive_registers import TripCode
 from labstand.session.loop import SessionLoop
 from labstand.session.record import RecordingPipe
 from labstand.session.safety import EStopError, SafetyMonitor
@@ -51,22 +50,6 @@ STOP_TIMEOUT_S = 3.0
 TAIL_S = 0.3
 #: How long the gauges may take to deliver their first block, s.
 FIRST_BLOCK_TIMEOUT_S = 2.0
-
-
-#: What a trip left from an earlier run means (labstand stands the watchdog down at
-#: every orderly end, so a watchdog trip means the controller died or lost the link).
-_TRIP_CAUSES = {
-    int(TripCode.WATCHDOG): ": the controller stopped toggling it while in control — "
-    "a killed labstand or a lost link",
-    int(TripCode.OVER_TRAVEL): ": the axis ran beyond its stroke",
-}
-
-
-def _trip_text(state: DriveState) -> str:
-    """``trip 30 (watchdog: why)``, or ``trip 45`` for a code without a name."""
-    code, name = state.trip_code, state.trip_name
-    why = _TRIP_CAUSES.get(code, "")
-    return f"trip {code}" + ("" if name == f"trip {code}" else f" ({name}{why})")
 
 
 class PreflightError(Exception):
@@ -144,7 +127,7 @@ class Session(SessionLoop):
             state = self._ask(self.drive.poll, "does not answer")
         if state.tripped:
             raise PreflightError(
-                f"{self.drive.name} is tripped: {_trip_text(state)}; find the cause, then "
+                f"{self.drive.name} is tripped: {state.trip_description}; find the cause, then "
                 "run again with --reset-trip",
                 refused=True,
             )
