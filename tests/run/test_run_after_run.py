@@ -88,6 +88,7 @@ def test_ten_runs_then_a_fault_a_refusal_and_a_reset(
         result = run(f"run{i}.mcap")
         assert result.code == 0, f"run {i + 1}: {result.err}"
         assert "Done: drive disabled;" in result.out
+        assert "samples, 0 lost, 0 corrupt)" in result.out  # joining the stream is no fault
         assert drive.trip_after_quiet() == 0, f"the drive tripped after run {i + 1}"
         assert drive.read(pr.STATUS_WORD) & pr.StatusBit.HEALTHY.mask
 
