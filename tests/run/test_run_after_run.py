@@ -6,11 +6,17 @@ One ``labstand stand-sim`` process plays the stand that is always on (Modbus TCP
 (plain pymodbus, not labstand's driver; reads only, so it toggles no watchdog) waits
 until more than the watchdog's second of drive time has passed without labstand, then
 reads Pr 10.20: a drive left to its watchdog would have tripped (trip 30) by then.
+
+Stops labstand decides (an e-stop, Ctrl-C) leave the drive healthy too; a labstand killed
+while in control leaves trip 30, which the next pre-flight names and refuses.
 """
 
 from __future__ import annotations
 
+import subprocess
+import sys
 import threading
+import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
@@ -18,6 +24,7 @@ import pytest
 from pymodbus.client import ModbusTcpClient
 
 from drivers import unidrive_registers as pr
+from drivers.unidrive_registers import TripCode
 from labstand.errors import ExitCode
 from sim.hardware.process import StandProcess
 from tests.run.conftest import Outcome, wait_for
@@ -117,5 +124,56 @@ def test_ten_runs_then_a_fault_a_refusal_and_a_reset(
     assert not (tmp_path / "refused.mcap").exists()
 
     result = run("reset.mcap", "--reset-trip")
+    assert result.code == 0, result.err
+    assert drive.trip_after_quiet() == 0
+
+
+def test_stops_labstand_decides_leave_it_healthy_and_a_killed_run_leaves_trip_30(
+    labstand: Callable[..., Outcome],
+    ctrl_c: Callable[[Path, float, int], None],
+    standing_stand: tuple[Path, Observer],
+    tmp_path: Path,
+) -> None:
+    stand, drive = standing_stand
+
+    def run(name: str, *extra: str) -> Outcome:
+        return labstand("run", *BRIEF, "--stand", stand, *extra, "-o", tmp_path / name)
+
+    # an e-stop labstand decides (the weight is flung: slack): disabled, stood down
+    fling = ["--signal", "rectangular", "--amplitude-mm", "30", "--cycles", "2"]
+    result = run("flung.mcap", *fling)
+    assert result.code == ExitCode.ESTOP, result.err
+    assert result.last_error_line.startswith("labstand: e-stop: fibre slack")
+    assert drive.trip_after_quiet() == 0
+
+    out = tmp_path / "ctrl-c.mcap"
+    ctrl_c(out, 0.3, 1)
+    result = run("ctrl-c.mcap", "--cycles", "3")
+    assert result.code == ExitCode.INTERRUPTED, result.err
+    assert drive.trip_after_quiet() == 0
+
+    # labstand killed while in control: the drive trips on its watchdog, and stays so
+    killed = tmp_path / "killed.mcap"
+    args = ["run", *BRIEF, "--cycles", "6", "--stand", str(stand), "-o", str(killed)]
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "labstand", *args],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
+    try:
+        wait_for(killed.exists, 60.0, "the killed run to record")
+        time.sleep(0.5)  # into the motion
+    finally:
+        proc.kill()
+        proc.wait(10)
+    assert drive.trip_after_quiet() == TripCode.WATCHDOG
+
+    result = run("after-kill.mcap")
+    assert result.code == ExitCode.REFUSED, result.err
+    assert "is tripped: trip 30 (watchdog: the controller stopped toggling it while in " in (
+        result.last_error_line
+    )
+    assert "a killed labstand or a lost link)" in result.last_error_line
+    result = run("recovered.mcap", "--reset-trip")
     assert result.code == 0, result.err
     assert drive.trip_after_quiet() == 0
