@@ -158,8 +158,8 @@ class SessionLoop:
     def keepalive(self, period_s: float = 0.25) -> Iterator[None]:
         """Poll the drive from a thread while the caller waits (for a confirmation).
 
-        The drive's watchdog may be armed from an earlier run; without polls it would
-        trip while the operator reads the summary.
+        An orderly run stands the watchdog down at its end, but another controller may
+        have left it armed; without polls it would trip while the operator reads.
         """
         done = threading.Event()
 
