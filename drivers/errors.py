@@ -5,7 +5,8 @@ Exceptions (each also inherits the matching built-in, as python-can's do)::
     Exception
      └── DeviceError              anything a device driver raises
           ├── DriveError          the drive (drivers.unidrive_wire adds connection,
-          │                       reply, address, value and tripped errors under it)
+          │    │                  reply, address, value and tripped errors under it)
+          │    └── DriveNotReadyError  enable() before check_limits() passed
           ├── GaugeError          the gauge stream (drivers.gauge_stream adds more)
           ├── DeviceTimeoutError  (also TimeoutError) a device did not answer in time
           └── ClosedError         (also RuntimeError) a driver used after close()
@@ -16,7 +17,14 @@ Exceptions (each also inherits the matching built-in, as python-can's do)::
 
 from __future__ import annotations
 
-__all__ = ["ClosedError", "DeviceError", "DeviceTimeoutError", "DriveError", "GaugeError"]
+__all__ = [
+    "ClosedError",
+    "DeviceError",
+    "DeviceTimeoutError",
+    "DriveError",
+    "DriveNotReadyError",
+    "GaugeError",
+]
 
 
 class DeviceError(Exception):
@@ -25,6 +33,10 @@ class DeviceError(Exception):
 
 class DriveError(DeviceError):
     """Anything the drive driver raises."""
+
+
+class DriveNotReadyError(DriveError):
+    """``enable()`` before the drive's limits were checked on this connection."""
 
 
 class GaugeError(DeviceError):

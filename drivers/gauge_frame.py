@@ -208,6 +208,7 @@ class FrameParser:
         self.counters = ParserCounters()
         self._carry = b""
         self._in_garbage = False
+        self._lead_in = 0  # bytes skipped before the first valid frame
         self._last_seq: int | None = None  # unwrapped
         self._last_t_us = 0  # unwrapped
         self._long_gap_us = 32768 * 1e6 / rate_hz  # beyond this a u16 wrap may hide
@@ -262,7 +263,13 @@ class FrameParser:
         if not skipped:
             return
         runs = int(np.count_nonzero(nonempty))
-        if self._in_garbage and nonempty[0] and run_begin[0] == 0:
+        if self._last_seq is None and nonempty[0] and run_begin[0] == 0:
+            # before the first frame: a reader that opens a streaming port joins it
+            # mid-frame; that tail is no corruption, a lead-in of a frame or more is (once)
+            before = self._lead_in
+            self._lead_in += int(lengths[0])
+            runs -= 0 if before < FRAME_SIZE <= self._lead_in else 1
+        elif self._in_garbage and nonempty[0] and run_begin[0] == 0:
             runs -= 1  # the garbage run of the previous chunk goes on
         self.counters.skipped_bytes += skipped
         self.counters.corrupt += runs

@@ -20,8 +20,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from drivers.closing import ClosesOnExit
-from drivers.errors import ClosedError
-from drivers.limits import DriveLimits
+from drivers.errors import ClosedError, DriveNotReadyError
+from drivers.limits import DriveLimits, LimitError
 from drivers.signals import DriveProfile, SignalSpec
 from drivers.unidrive_profile import ProfileState
 from drivers.unidrive_registers import StatusBit, TripCode
@@ -51,6 +51,15 @@ SAMPLE_DTYPE = np.dtype(
         ("flags", "u1"),
     ]
 )
+
+
+#: What a trip found at pre-flight means. An orderly end stands the watchdog down, so a
+#: watchdog trip means the controller died or lost the link while in control.
+_TRIP_CAUSES = {
+    int(TripCode.WATCHDOG): ": the controller stopped toggling it while in control — "
+    "a killed labstand or a lost link",
+    int(TripCode.OVER_TRAVEL): ": the axis ran beyond its stroke",
+}
 
 
 @dataclass(frozen=True)
@@ -103,6 +112,14 @@ class DriveState:
         return self.trip_code != 0
 
     @property
+    def trip_description(self) -> str:
+        """``trip 30 (watchdog: why)``, or ``trip 45`` for a code without a name."""
+        code, name = self.trip_code, self.trip_name
+        if name == f"trip {code}":
+            return name
+        return f"trip {code} ({name}{_TRIP_CAUSES.get(code, '')})"
+
+    @property
     def trip_name(self) -> str:
         """A readable name of the trip code."""
         try:
@@ -152,16 +169,42 @@ class DriveInterface(_Device):
 
     The drive trips by itself unless ``poll()`` (or ``kick_watchdog()``) is called at
     least every 0.5 s once ``enable()`` armed the watchdog, so a dead controller stops
-    the stand.
+    the stand. A controller that ends in order calls ``stand_down()`` (``close()`` does):
+    the drive is disabled, then the watchdog is released, and the drive stays healthy for
+    the next run. A trip is left only by a real fault: the drive's own, or a controller
+    that died or lost the link.
     """
 
     name: str = "drive"
     kind: str = "driver"
+    _limits_checked: bool = False
 
     @property
     @abstractmethod
     def limits(self) -> DriveLimits:
         """The limits profiles are planned and checked against."""
+
+    def check_limits(self) -> DriveLimits:
+        """The drive's own commissioned limits; LimitError if labstand's are looser.
+
+        Part of every pre-flight: ``enable()`` is refused on a connection where this has
+        not passed, so nothing moves under limits nobody compared with the drive's.
+        """
+        self._check_open()
+        theirs = self._read_limits()
+        mine = self.limits
+        for what, own, drive, unit in (
+            ("amplitude", mine.amplitude_max_m, theirs.amplitude_max_m, "m"),
+            ("speed", mine.speed_max_m_s, theirs.speed_max_m_s, "m/s"),
+            ("acceleration", mine.accel_max_m_s2, theirs.accel_max_m_s2, "m/s²"),
+        ):
+            if own > drive * (1 + 1e-6):
+                raise LimitError(
+                    f"{self.name}: labstand's {what} limit {own:g} {unit} exceeds the "
+                    f"drive's commissioned {drive:g} {unit}"
+                )
+        self._limits_checked = True
+        return theirs
 
     def poll(self) -> DriveState:
         """Read position, velocity, profile state, status and trip; toggles the watchdog."""
@@ -169,14 +212,36 @@ class DriveInterface(_Device):
         return self._poll()
 
     def enable(self) -> None:
-        """Enable the drive (control word ENABLE + AUTO); arms the watchdog."""
+        """Enable the drive (control word ENABLE + AUTO); arms the watchdog.
+
+        Raises
+        ------
+        DriveNotReadyError
+            ``check_limits()`` has not passed on this connection (nothing written).
+        """
         self._check_open()
+        if not self._limits_checked:
+            raise DriveNotReadyError(
+                f"{self.name}: enable refused: the drive's limits were not checked "
+                "(pre-flight: check_limits())"
+            )
         self._enable()
 
     def disable(self) -> None:
         """Disable the drive at once (the motor coasts): the emergency stop."""
         self._check_open()
         self._disable()
+
+    def stand_down(self) -> None:
+        """Disable the drive, then release its watchdog: it stays disabled and healthy.
+
+        The end of every orderly run (and ``close()``). A later ``enable()`` arms the
+        watchdog again. A tripped drive stays tripped (``reset_trip`` clears it).
+        """
+        self._check_open()
+        self._disable()
+        self._stand_down()
+        log.info("%s: disabled, watchdog stood down", self.name)
 
     def load_profile(self, spec: SignalSpec) -> DriveProfile:
         """Plan a motion within the limits and load it into the drive (nothing moves).
@@ -212,6 +277,8 @@ class DriveInterface(_Device):
         self._kick_watchdog()
 
     @abstractmethod
+    def _read_limits(self) -> DriveLimits: ...
+    @abstractmethod
     def _poll(self) -> DriveState: ...
     @abstractmethod
     def _enable(self) -> None: ...
@@ -229,6 +296,8 @@ class DriveInterface(_Device):
     def _reset_trip(self) -> None: ...
     @abstractmethod
     def _kick_watchdog(self) -> None: ...
+    @abstractmethod
+    def _stand_down(self) -> None: ...
 
 
 @dataclass(frozen=True)

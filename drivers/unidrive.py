@@ -21,6 +21,11 @@ pymodbus returns error replies instead of raising them; they become exceptions h
           ├── DriveProfileError (+ValueError)          the drive program refused a profile
           └── DriveClosedError (+ClosedError)          used after close()
 
+The control word, and with it the watchdog of bit 14, counts only while Pr 6.43 = 1
+(HARDWARE.md): ``enable`` sets it, ``stand_down`` (the end of an orderly run, and
+``close``) writes the disabled word, then Pr 6.43 = 0, so the drive stays disabled and
+healthy instead of tripping on the watchdog once polls stop.
+
 ``LimitError`` (drivers.limits) is raised before anything is written when a profile
 breaks labstand's limits.
 """
@@ -38,7 +43,7 @@ from pymodbus.pdu import ModbusPDU
 
 from drivers import unidrive_registers as pr
 from drivers.interfaces import DriveInterface, DriveState
-from drivers.limits import DriveLimits, LimitError
+from drivers.limits import DriveLimits
 from drivers.signals import DriveProfile, SignalSpec, plan_motion
 from drivers.unidrive_profile import (
     ProfileState,
@@ -98,7 +103,7 @@ class UnidriveSP(DriveInterface):
         fake); the driver closes it. Build real ones with ``open_unidrive``.
     limits
         Labstand's limits; profiles are planned against them and refused before anything
-        moves. ``check_drive_limits()`` compares them with the drive's own.
+        moves. ``check_limits()`` compares them with the drive's own (before ``enable``).
     device_id
         Modbus unit id (Pr 11.23 for RTU).
     retries
@@ -244,25 +249,19 @@ class UnidriveSP(DriveInterface):
         self._write_control((self._cw & ControlBit.WATCHDOG.mask) | ControlBit.AUTO.mask)
         log.info("%s: disabled", self.name)
 
-    def check_drive_limits(self) -> DriveLimits:
-        """The drive's commissioned limits; LimitError if labstand's exceed them."""
+    def _stand_down(self) -> None:
+        # after _disable: the word is 128 (AUTO, output off); clearing Pr 6.43 takes the
+        # control word out of force, its watchdog with it [HARDWARE.md: the word is active
+        # only with Pr 6.43 = 1; that the real drive then forgets bit 14 is unconfirmed]
+        self.write_raw([pr.CONTROL_WORD_ENABLE], [0])
+
+    def _read_limits(self) -> DriveLimits:
+        """The limits commissioned on the drive (Pr 20.28–20.30)."""
         amp, speed, accel = (
             reg.to_value(raw)
             for reg, raw in zip(pr.LIMIT_BLOCK, self.read_raw(pr.LIMIT_BLOCK), strict=True)
         )
-        drive = DriveLimits(amp, speed, accel)
-        mine = self._limits
-        for what, own, theirs, unit in (
-            ("amplitude", mine.amplitude_max_m, amp, "m"),
-            ("speed", mine.speed_max_m_s, speed, "m/s"),
-            ("acceleration", mine.accel_max_m_s2, accel, "m/s²"),
-        ):
-            if own > theirs * (1 + 1e-6):
-                raise LimitError(
-                    f"{self.name}: labstand's {what} limit {own:g} {unit} exceeds the "
-                    f"drive's commissioned {theirs:g} {unit}"
-                )
-        return drive
+        return DriveLimits(amp, speed, accel)
 
     def _load_profile(self, spec: SignalSpec) -> DriveProfile:
         plan_motion(spec, self._limits)  # refuse before anything is written
@@ -306,8 +305,9 @@ class UnidriveSP(DriveInterface):
     def _close(self) -> None:
         try:
             self._disable()
+            self._stand_down()
         except DriveError as err:
-            log.warning("%s: could not disable on close: %s", self.name, err)
+            log.warning("%s: could not disable (and stand down) on close: %s", self.name, err)
         finally:
             self._client.close()
 

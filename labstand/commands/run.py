@@ -27,7 +27,6 @@ from typing import Any
 from drivers.signals import SignalSpec, plan_motion
 from labstand.commands.common import add_stand_options, config_with_mass, load_stand
 from labstand.commands.simulate import add_signal_options, signal_from_args
-from labstand.display import make_display
 from labstand.errors import CommandError, ExitCode
 from labstand.session import (
     Outcome,
@@ -37,9 +36,10 @@ from labstand.session import (
     Session,
     StopRequest,
 )
-from labstand.session_devices import BACKENDS, Devices, default_backend, open_devices
-from labstand.session_record import RecordingPipe
-from labstand.session_safety import EStopError, SafetyLimits
+from labstand.session.devices import BACKENDS, Devices, default_backend, open_devices
+from labstand.session.display import make_display
+from labstand.session.record import RecordingPipe
+from labstand.session.safety import EStopError, SafetyLimits
 from recordings.base import FORMATS, open_writer
 from recordings.schema import Effect, RecordingMetadata, make_metadata
 from sim.config import StandConfig

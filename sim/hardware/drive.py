@@ -11,8 +11,11 @@ steps. It implements the same parameter table as the driver
   a 16-bit read of a 32-bit parameter returns the low word only;
 * the control word (active when Pr 6.43 = 1 and AUTO is set): ENABLE, RUN FWD / RUN REV /
   RUN with FWD/REV, REMOTE (speed mode from Pr 1.21), TRIP, RESET and the watchdog
-  (armed by the first 0 → 1 edge of bit 14; trip 30 when the next edge is more than 1 s
-  late);
+  (armed by the first 0 → 1 edge of bit 14 while the word is active; trip 30 when the
+  next edge is more than 1 s late). The watchdog is a bit of the control word, so it
+  stands down with it: clearing Pr 6.43 (or AUTO) disarms it, and it re-arms only at a
+  new 0 → 1 edge once the word is active again. A controller that died leaves the word
+  active and the watchdog armed, so the drive trips;
 * trips: watchdog (30), over-travel (41: |x| beyond the amplitude limit + margin),
   control-word trip (52), user trips 40–89 written to Pr 10.38; writing 100 resets. A
   trip disables the output; after a reset the drive waits for a new ENABLE edge;
@@ -190,6 +193,13 @@ class SimulatedDrive:
         self.trip_code = 0
         self._wd_armed = False
 
+    def _word_inactive(self) -> None:
+        """The control word stopped counting (Pr 6.43 or AUTO cleared): off, watchdog down."""
+        if self._wd_armed:
+            log.info("simulated drive: control word inactive at %.3f s, watchdog down", self.t_s)
+        self._wd_armed = False
+        self._output_off()
+
     def _output_off(self) -> None:
         if self.profile_state is ProfileState.RUNNING:
             self.profile_state = ProfileState.ABORTED
@@ -200,7 +210,7 @@ class SimulatedDrive:
         rise, fall = new & ~old, old & ~new
         active = self.params[pr.CONTROL_WORD_ENABLE] == 1 and bool(new & ControlBit.AUTO.mask)
         if not active:
-            self._output_off()
+            self._word_inactive()
             return
         if rise & ControlBit.WATCHDOG.mask:
             self._wd_armed, self._wd_last_edge_s = True, self.t_s
@@ -361,6 +371,8 @@ class SimulatedDrive:
         self.params[reg] = raw
         if reg is pr.CONTROL_WORD:
             self._control_word(old & 0xFFFF, raw & 0xFFFF)
+        elif reg is pr.CONTROL_WORD_ENABLE and raw != 1:
+            self._word_inactive()
         elif reg in (pr.CONTROL_WORD_ENABLE, pr.DRIVE_ENABLE) and not self.enabled:
             self._output_off()
         elif (

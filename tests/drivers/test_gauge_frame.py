@@ -85,6 +85,27 @@ def test_garbage_before_the_first_frame() -> None:
     assert (p.counters.corrupt, p.counters.skipped_bytes) == (1, 50)
 
 
+@pytest.mark.parametrize("chunk", [7, 24, 1000])
+def test_joining_a_stream_mid_frame_is_not_corruption(chunk: int) -> None:
+    # a reader opening a port that already streams starts inside a frame
+    stream = frames(20)[13:]
+    p = FrameParser()
+    out = np.concatenate([p.feed(stream[i : i + chunk]) for i in range(0, len(stream), chunk)])
+    assert out["seq"].tolist() == list(range(1, 20))
+    assert (p.counters.corrupt, p.counters.skipped_bytes, p.counters.lost) == (0, 11, 0)
+    p.feed(b"\x00\x01\x02" + frames(1, seq0=20, t0=10_000))  # later garbage still counts
+    assert (p.counters.corrupt, p.counters.skipped_bytes) == (1, 14)
+
+
+@pytest.mark.parametrize("chunk", [7, 1000])
+def test_a_lead_in_of_a_frame_or_more_is_corruption_once(chunk: int) -> None:
+    stream = b"\xff" * 30 + frames(5)
+    p = FrameParser()
+    out = np.concatenate([p.feed(stream[i : i + chunk]) for i in range(0, len(stream), chunk)])
+    assert out["seq"].tolist() == list(range(5))
+    assert (p.counters.corrupt, p.counters.skipped_bytes) == (1, 30)
+
+
 def test_a_corrupted_frame_is_lost_and_counted() -> None:
     data = bytearray(frames(10))
     data[5 * 24 + 10] ^= 0x40  # one bit flipped in frame 5's force

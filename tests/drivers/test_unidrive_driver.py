@@ -6,6 +6,7 @@ import pytest
 from pymodbus.exceptions import ConnectionException, ModbusIOException
 
 from drivers import unidrive_registers as pr
+from drivers.errors import DriveNotReadyError
 from drivers.interfaces import ClosedError, DriveInterface
 from drivers.limits import DriveLimits, LimitError
 from drivers.signals import Shape, SignalSpec
@@ -44,7 +45,9 @@ def client(sim: SimulatedDrive) -> InProcessClient:
 
 @pytest.fixture
 def drive(client: InProcessClient) -> UnidriveSP:
-    return UnidriveSP(client, LIMITS, retries=2)
+    d = UnidriveSP(client, LIMITS, retries=2)
+    d.check_limits()  # the pre-flight step enable() requires
+    return d
 
 
 def run_for(sim: SimulatedDrive, drive: UnidriveSP, seconds: float, poll_hz: float = 20.0) -> None:
@@ -138,12 +141,29 @@ def test_drive_program_refusal_is_a_profile_error(sim: SimulatedDrive) -> None:
         loose.load_profile(fast)
     assert err.value.reason is RejectReason.LIMITS
     with pytest.raises(LimitError, match="speed limit 3 m/s exceeds the drive's"):
-        loose.check_drive_limits()
+        loose.check_limits()
 
 
 def test_drive_limits_are_read_back(drive: UnidriveSP) -> None:
-    limits = drive.check_drive_limits()
+    limits = drive.check_limits()
     assert limits == LIMITS
+
+
+def test_enable_is_refused_until_the_limits_were_checked(
+    client: InProcessClient, sim: SimulatedDrive
+) -> None:
+    fresh = UnidriveSP(client, LIMITS)
+    with pytest.raises(DriveNotReadyError, match="limits were not checked"):
+        fresh.enable()
+    assert not sim.enabled and sim.params[pr.CONTROL_WORD_ENABLE] == 0  # nothing written
+    loose = UnidriveSP(client, DriveLimits(0.09, 3.0, 50.0))
+    with pytest.raises(LimitError):
+        loose.check_limits()
+    with pytest.raises(DriveNotReadyError):
+        loose.enable()  # a failed check does not count
+    fresh.check_limits()
+    fresh.enable()
+    assert sim.enabled
 
 
 def test_trip_and_reset(drive: UnidriveSP, sim: SimulatedDrive) -> None:
@@ -229,6 +249,32 @@ def test_close_disables_and_refuses_work(drive: UnidriveSP, sim: SimulatedDrive)
     with pytest.raises(ClosedError):
         drive.enable()
     drive.close()  # idempotent
+
+
+def test_stand_down_leaves_the_drive_disabled_and_healthy(
+    drive: UnidriveSP, sim: SimulatedDrive
+) -> None:
+    drive.enable()
+    run_for(sim, drive, 1.0)
+    drive.stand_down()
+    sim.advance(round(3 * RATE))  # no polls: a watchdog left armed would trip at 1 s
+    state = drive.poll()
+    assert state.healthy and not state.active and not state.tripped
+    assert sim.params[pr.CONTROL_WORD_ENABLE] == 0
+    drive.stand_down()  # idempotent
+    drive.enable()  # the next run enables and arms again
+    run_for(sim, drive, 1.0)
+    assert drive.poll().active
+    sim.advance(round(1.5 * RATE))
+    assert drive.poll().trip_code == TripCode.WATCHDOG
+
+
+def test_close_stands_the_watchdog_down(drive: UnidriveSP, sim: SimulatedDrive) -> None:
+    drive.enable()
+    run_for(sim, drive, 0.5)
+    drive.close()
+    sim.advance(round(3 * RATE))
+    assert sim.trip_code == 0 and not sim.enabled
 
 
 def test_exception_tree() -> None:

@@ -133,6 +133,53 @@ def test_watchdog_is_armed_by_its_first_edge_and_trips_after_one_second() -> Non
     assert d.trips[-1][0] == pytest.approx(last_edge + 1.0, abs=1.5 / RATE)
 
 
+def armed_and_toggled() -> SimulatedDrive:
+    d = enabled_drive()
+    for word in (AUTO | ENABLE | WD, AUTO | ENABLE):  # the first 0 → 1 edge arms it
+        write(d, pr.CONTROL_WORD, word)
+        d.advance(round(0.2 * RATE))
+    return d
+
+
+@pytest.mark.parametrize("how", ["Pr 6.43 = 0", "AUTO cleared"])
+def test_watchdog_stands_down_with_the_control_word(how: str) -> None:
+    # HARDWARE.md: the control word (bit 14 included) acts only with Pr 6.43 = 1 and AUTO
+    d = armed_and_toggled()
+    write(d, pr.CONTROL_WORD, AUTO)  # disabled first, as labstand does
+    if how == "AUTO cleared":
+        write(d, pr.CONTROL_WORD, 0)
+    else:
+        write(d, pr.CONTROL_WORD_ENABLE, 0)
+    d.advance(round(5 * RATE))
+    assert d.trip_code == 0 and not d.enabled
+    assert read(d, pr.STATUS_WORD) & StatusBit.HEALTHY.mask
+    # toggling bit 14 while the word is inactive arms nothing
+    write(d, pr.CONTROL_WORD, WD)
+    d.advance(round(2 * RATE))
+    assert d.trip_code == 0
+
+
+def test_watchdog_re_arms_at_the_next_edge_after_a_stand_down() -> None:
+    d = armed_and_toggled()
+    write(d, pr.CONTROL_WORD, AUTO)
+    write(d, pr.CONTROL_WORD_ENABLE, 0)
+    d.advance(round(3 * RATE))
+    write(d, pr.CONTROL_WORD_ENABLE, 1)
+    write(d, pr.CONTROL_WORD, AUTO | ENABLE)
+    d.advance(round(1.5 * RATE))
+    assert d.trip_code == 0  # not armed again until its edge (no stale deadline)
+    write(d, pr.CONTROL_WORD, AUTO | ENABLE | WD)
+    d.advance(round(1.5 * RATE))
+    assert d.trip_code == TripCode.WATCHDOG  # and then a dead controller trips it again
+
+
+def test_controller_that_stops_with_the_word_active_trips() -> None:
+    d = armed_and_toggled()
+    write(d, pr.CONTROL_WORD, AUTO)  # disabled, but the word (and its watchdog) in force
+    d.advance(round(1.5 * RATE))
+    assert d.trip_code == TripCode.WATCHDOG
+
+
 def test_user_trip_reset_and_enable_edge() -> None:
     d = enabled_drive()
     write(d, pr.USER_TRIP, 45)

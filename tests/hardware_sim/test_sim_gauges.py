@@ -134,6 +134,7 @@ def test_gauges_follow_the_drive_through_the_model(config: StandConfig) -> None:
             SerialGaugeStream(ep.gauges, config.gauges) as stream,
             open_unidrive(ep.modbus, config.drive) as drive,
         ):
+            drive.check_limits()
             drive.enable()
             drive.load_profile(spec)
             drive.start()

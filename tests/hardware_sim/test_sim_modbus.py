@@ -46,6 +46,7 @@ def link(request: pytest.FixtureRequest, config: StandConfig) -> Iterator[tuple[
 @pytest.fixture
 def drive(link: tuple[StandThread, str], config: StandConfig) -> Iterator[UnidriveSP]:
     with open_unidrive(link[1], config.drive, timeout_s=0.5) as d:
+        d.check_limits()
         yield d
 
 

@@ -15,11 +15,11 @@ from drivers.interfaces import SAMPLE_DTYPE, DriveState
 from drivers.signals import Shape, SignalSpec, plan_motion
 from drivers.unidrive_profile import ProfileState
 from labstand.commands.run import config_with_mass
-from labstand.display import LiveDisplay, PlainDisplay, RunStatus, make_display
 from labstand.errors import ExitCode
-from labstand.session_devices import default_backend
-from labstand.session_record import RunClock
-from labstand.session_safety import EStopError, SafetyLimits, SafetyMonitor
+from labstand.session.devices import default_backend
+from labstand.session.display import LiveDisplay, PlainDisplay, RunStatus, make_display
+from labstand.session.record import RunClock
+from labstand.session.safety import EStopError, SafetyLimits, SafetyMonitor
 from sim.config import ConfigError, config_from_dict, default_config
 from sim.hardware.faults import Fault, FaultKind, FaultPlan, parse_fault
 from tests.run.conftest import SHORT, Outcome

@@ -1,12 +1,12 @@
 """The acquisition session: pre-flight, homing, the run, and a safe stop on every path.
 
 The session receives ready-built drivers, a ``DriveInterface`` and a ``GaugeSource``
-(``labstand.session_devices`` builds them for the stand or the simulated stand); it never
+(``labstand.session.devices`` builds them for the stand or the simulated stand); it never
 knows which. Threads:
 
 * the gauge source's reader thread parses the serial port and queues blocks
   (drivers.gauge_stream); it never waits on anybody;
-* the session's loop (``labstand.session_loop``), in the caller's thread, takes every
+* the session's loop (``labstand.session.loop``), in the caller's thread, takes every
   queued block, checks it, stamps it and hands it on, and polls the drive at
   ``poll_hz`` (each poll toggles the drive's watchdog, so a dead labstand trips it);
 * the ``RecordingPipe``'s writer thread does all the disk I/O.
@@ -32,9 +32,9 @@ from drivers.errors import DriveError, GaugeError
 from drivers.interfaces import DriveState, GaugeStats
 from drivers.signals import DriveProfile, SignalSpec
 from drivers.unidrive_profile import ProfileState
-from labstand.session_loop import SessionLoop
-from labstand.session_record import RecordingPipe
-from labstand.session_safety import EStopError, SafetyMonitor
+from labstand.session.loop import SessionLoop
+from labstand.session.record import RecordingPipe
+from labstand.session.safety import EStopError, SafetyMonitor
 
 log = logging.getLogger(__name__)
 
@@ -127,8 +127,8 @@ class Session(SessionLoop):
             state = self._ask(self.drive.poll, "does not answer")
         if state.tripped:
             raise PreflightError(
-                f"{self.drive.name} is tripped: trip {state.trip_code} ({state.trip_name}); "
-                "find the cause, then run again with --reset-trip",
+                f"{self.drive.name} is tripped: {state.trip_description}; find the cause, then "
+                "run again with --reset-trip",
                 refused=True,
             )
         if not state.healthy:
@@ -137,9 +137,7 @@ class Session(SessionLoop):
                 refused=True,
             )
         first = self._first_block()
-        check_limits = getattr(self.drive, "check_drive_limits", None)
-        if callable(check_limits):
-            self._ask(check_limits, "cannot report its limits")
+        self._ask(self.drive.check_limits, "cannot report its limits")
         try:
             profile = self.drive.load_profile(spec)
         except DriveError as err:

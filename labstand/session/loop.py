@@ -23,9 +23,9 @@ from numpy.typing import NDArray
 from drivers.errors import ClosedError, DriveError, GaugeError
 from drivers.interfaces import DriveInterface, DriveState, GaugeSource, GaugeStats
 from drivers.signals import DriveProfile
-from labstand.display import Display, RunStatus
-from labstand.session_record import RecordingPipe, RunClock
-from labstand.session_safety import EStopError, SafetyLimits, SafetyMonitor
+from labstand.session.display import Display, RunStatus
+from labstand.session.record import RecordingPipe, RunClock
+from labstand.session.safety import EStopError, SafetyLimits, SafetyMonitor
 from recordings.schema import concat_blocks
 
 log = logging.getLogger(__name__)
@@ -158,8 +158,8 @@ class SessionLoop:
     def keepalive(self, period_s: float = 0.25) -> Iterator[None]:
         """Poll the drive from a thread while the caller waits (for a confirmation).
 
-        The drive's watchdog may be armed from an earlier run; without polls it would
-        trip while the operator reads the summary.
+        An orderly run stands the watchdog down at its end, but another controller may
+        have left it armed; without polls it would trip while the operator reads.
         """
         done = threading.Event()
 
@@ -194,10 +194,27 @@ class SessionLoop:
         self.drive_disabled, self.disable_error = True, ""
         return True
 
-    def shutdown(self) -> None:
-        """Disable and close the drive, close the gauges (idempotent)."""
+    def stand_down(self) -> bool:
+        """Disable the drive and release its watchdog (it stays healthy); True if done."""
+        if self.drive.closed or not self.drive_ok:
+            return False
         try:
-            if not self.drive.closed and self.drive_ok:
+            self.drive.stand_down()
+        except (DriveError, ClosedError) as err:
+            log.error("could not stand the drive's watchdog down: %s", err)
+            return False
+        self.drive_disabled, self.disable_error, self.phase = True, "", "disabled"
+        return True
+
+    def shutdown(self) -> None:
+        """Disable the drive and stand its watchdog down, close the devices (idempotent).
+
+        An orderly end (done, Ctrl-C, an e-stop labstand decided) leaves the drive
+        disabled and healthy for the next run. A drive that stopped answering cannot be
+        told: its watchdog trips it, and the next pre-flight reports that trip.
+        """
+        try:
+            if not self.drive.closed and self.drive_ok and not self.stand_down():
                 self.disable()
         finally:
             self.drive.close()
