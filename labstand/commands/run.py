@@ -204,6 +204,7 @@ def run(args: argparse.Namespace) -> int:
             live = stack.enter_context(
                 LiveView.open(plan.viewer, "labstand run", params, plan.config.sample_rate_hz)
             )
+            _say(f"live view: {live.describe()}")
         return _run_devices(args, plan, live)
 
 
@@ -223,7 +224,6 @@ def _run_devices(args: argparse.Namespace, plan: _Plan, live: LiveView | None) -
         _say(f"  {plan.backend}: {devices.where}")
         display = make_display(sys.stdout)
         if live is not None:
-            _say(f"  live view: {live.describe()}")
             display = live.display(display)
         session = Session(devices.drive, devices.gauges, plan.safety, display)
         try:

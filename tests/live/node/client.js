@@ -75,8 +75,9 @@ function run(ws) {
     }
   });
   client.on("close", () => {
-    console.log(JSON.stringify({ protocol: ws.protocol, server: serverName, topics }));
-    process.exit(0);
+    // exit once the pipe took everything (process.exit alone truncates a piped stdout)
+    const report = JSON.stringify({ protocol: ws.protocol, server: serverName, topics });
+    process.stdout.write(report + "\n", () => process.exit(0));
   });
 }
 
