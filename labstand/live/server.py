@@ -7,7 +7,7 @@ time the stream started (so Foxglove shows the run at the time it happened):
 =================== ==========================================================
 ``/gauges``         every sample: ``seq``, ``t_ns``, ``x_mm``, ``u_mm``, ``force_n``,
                     ``flags`` (2 kHz)
-``/command``        the planned drive position ``x_cmd_mm`` (every 10th sample)
+``/command``        the planned drive position ``x_cmd_mm`` (one per 5 ms)
 ``/drive``          each drive poll: position, speed, status word, trip, enabled
 ``/events``         start, stop, e-stop, faults, notes (``foxglove.Log``)
 ``/model``          the baseline model fed the measured x: ``u_mm``, ``force_n``
@@ -24,11 +24,16 @@ from __future__ import annotations
 import json
 import logging
 import math
+import threading
 import time
 from collections.abc import Sequence
 from typing import Any
 
+import foxglove
 import numpy as np
+from foxglove.channels import LogChannel
+from foxglove.messages import Log, LogLevel, Timestamp
+from foxglove.websocket import ChannelView, Client, ServerListener
 from numpy.typing import NDArray
 
 from drivers.closing import ClosesOnExit
@@ -38,10 +43,10 @@ from labstand.live.model import ModelBlock
 
 log = logging.getLogger(__name__)
 
-__all__ = ["COMMAND_EVERY", "TOPICS", "LiveServer"]
+__all__ = ["COMMAND_EVERY_NS", "TOPICS", "LiveServer"]
 
-#: /command carries every n-th sample: the planned motion is smooth.
-COMMAND_EVERY = 10
+#: /command carries one planned position per this span, ns: the planned motion is smooth.
+COMMAND_EVERY_NS = 5_000_000
 #: How long a stopping server waits for clients to take what is in flight, s.
 LINGER_S = 0.5
 #: Messages a client may have outstanding before its oldest are dropped (2 s of all
@@ -87,6 +92,17 @@ def _finite(value: float) -> float | None:
     return value if math.isfinite(value) else None  # JSON has no NaN
 
 
+class _Listener(ServerListener):
+    """Notes that a client subscribed to something."""
+
+    def __init__(self) -> None:
+        self.subscribed = threading.Event()
+
+    def on_subscribe(self, client: Client, channel: ChannelView) -> None:
+        """A client subscribed to a channel."""
+        self.subscribed.set()
+
+
 class LiveServer(ClosesOnExit):
     """A Foxglove WebSocket server with labstand's topics.
 
@@ -95,12 +111,10 @@ class LiveServer(ClosesOnExit):
     """
 
     def __init__(self, address: ViewerAddress, name: str, epoch_ns: int | None = None) -> None:
-        import foxglove
-        from foxglove.channels import LogChannel
-
         self.address = address
         self.epoch_ns = time.time_ns() if epoch_ns is None else epoch_ns
         self._context = foxglove.Context()
+        self._listener = _Listener()
         try:
             self._server = foxglove.start_server(
                 name=name,
@@ -108,6 +122,7 @@ class LiveServer(ClosesOnExit):
                 port=address.port,
                 context=self._context,
                 message_backlog_size=BACKLOG,
+                server_listener=self._listener,
             )
         except RuntimeError as err:
             reason = str(err).removeprefix("FoxgloveError: ")
@@ -118,6 +133,7 @@ class LiveServer(ClosesOnExit):
         }
         self._events = LogChannel("/events", context=self._context)
         self._closed = False
+        self._command_slot = -1
 
     @property
     def port(self) -> int:
@@ -129,6 +145,10 @@ class LiveServer(ClosesOnExit):
         """Where Foxglove connects (Open connection → Foxglove WebSocket)."""
         host = f"[{self.address.host}]" if ":" in self.address.host else self.address.host
         return f"ws://{host}:{self.port}"
+
+    def wait_client(self, timeout_s: float | None = None) -> bool:
+        """Wait until a client subscribed to a topic; False on the time-out."""
+        return self._listener.subscribed.wait(timeout_s)
 
     def subscribed(self, topic: str) -> bool:
         """True if a client subscribed to ``topic``."""
@@ -155,10 +175,13 @@ class LiveServer(ClosesOnExit):
         self._log_rows("/gauges", t_ns, rows)
 
     def command(self, command: NDArray[np.void]) -> None:
-        """Every COMMAND_EVERY-th planned position (COMMAND_DTYPE), by sample time."""
+        """The first planned position (COMMAND_DTYPE) in each COMMAND_EVERY_NS span."""
         if not self.subscribed("/command") or not len(command):
             return
-        pick = command[(command["t_ns"] // 500_000) % COMMAND_EVERY == 0]
+        slot = command["t_ns"] // COMMAND_EVERY_NS
+        first = np.diff(slot, prepend=self._command_slot) > 0
+        self._command_slot = int(slot[-1])
+        pick = command[first]
         t_ns = pick["t_ns"].tolist()
         rows = [
             {"t_ns": t, "x_cmd_mm": _finite(x)}
@@ -188,8 +211,6 @@ class LiveServer(ClosesOnExit):
 
     def event(self, t_ns: int, kind: str, text: str) -> None:
         """An event as a ``foxglove.Log`` message (name: the kind)."""
-        from foxglove.messages import Log, LogLevel, Timestamp
-
         stamp = self.epoch_ns + int(t_ns)
         level = getattr(LogLevel, _LEVELS.get(kind, "Info"))
         message = Log(

@@ -17,9 +17,10 @@ from typing import IO, Any
 
 import pytest
 
+from tests.recordings.conftest import meta
 from tests.run.conftest import labstand, no_leaks, run_process
 
-__all__ = ["labstand", "no_leaks", "run_process"]
+__all__ = ["labstand", "meta", "no_leaks", "run_process"]
 
 NODE_DIR = Path(__file__).parent / "node"
 
