@@ -26,9 +26,9 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).parent))
-from bench_recordings import CPU_S, make_data, write  # noqa: E402
+from bench_recordings import CPU_S, make_data, write
 
-from recordings import open_recording  # noqa: E402
+from recordings import open_recording
 
 VARIANTS = {
     "before": {"plot_rate_hz": 100.0, "time_s": False},
