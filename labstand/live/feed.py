@@ -13,8 +13,9 @@ from __future__ import annotations
 import logging
 import queue
 import threading
+import time
 from dataclasses import dataclass
-from typing import Any, Protocol
+from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
 from numpy.typing import NDArray
@@ -53,6 +54,15 @@ class Publisher(Protocol):
 class _Item:
     kind: str  # gauges | drive | event
     payload: Any
+    t_ns: int  # on the recording's axis (a block's last sample)
+    wall_ns: int  # when it was offered
+
+
+@runtime_checkable
+class _HasEpoch(Protocol):
+    """A publisher whose log times are ``epoch_ns`` + the recording's time."""
+
+    epoch_ns: int
 
 
 class LiveFeed(ClosesOnExit):
@@ -78,11 +88,13 @@ class LiveFeed(ClosesOnExit):
         self.published = 0
         self._queue: queue.Queue[_Item | None] = queue.Queue(maxsize=capacity)
         self._stop = threading.Event()
+        self._anchored = False
         self._thread = threading.Thread(target=self._run, name="foxglove viewer", daemon=True)
         self._thread.start()
 
     # ---- the acquisition's side: never blocks ------------------------------------
-    def _offer(self, item: _Item, count: int) -> None:
+    def _offer(self, kind: str, payload: Any, t_ns: int, count: int) -> None:
+        item = _Item(kind, payload, t_ns, time.time_ns())
         try:
             self._queue.put_nowait(item)
         except queue.Full:
@@ -90,15 +102,15 @@ class LiveFeed(ClosesOnExit):
 
     def offer_gauges(self, gauges: NDArray[np.void], command: NDArray[np.void]) -> None:
         """A gauges block (GAUGES_DTYPE) and the command at its samples."""
-        self._offer(_Item("gauges", (gauges, command)), len(gauges))
+        self._offer("gauges", (gauges, command), int(gauges["t_ns"][-1]), len(gauges))
 
     def offer_drive(self, row: dict[str, Any]) -> None:
         """One drive poll (a ``RunClock.drive_row``; copied, the caller may change it)."""
-        self._offer(_Item("drive", dict(row)), 1)
+        self._offer("drive", dict(row), int(row["t_ns"]), 1)
 
     def offer_event(self, t_ns: int, kind: str, text: str) -> None:
         """One event."""
-        self._offer(_Item("event", (t_ns, kind, text)), 1)
+        self._offer("event", (t_ns, kind, text), t_ns, 1)
 
     def summary(self) -> str:
         """A few words for the display."""
@@ -116,6 +128,11 @@ class LiveFeed(ClosesOnExit):
                     log.warning("live view: publishing %s failed: %s", item.kind, err)
 
     def _publish(self, item: _Item) -> None:
+        if not self._anchored and isinstance(self.publisher, _HasEpoch):
+            # log time = the wall time the first item reached the feed, then the
+            # recording's clock: each sample stamped (near) when it arrived
+            self.publisher.epoch_ns = item.wall_ns - item.t_ns
+            self._anchored = True
         if item.kind == "gauges":
             gauges, command = item.payload
             self.publisher.gauges(gauges)

@@ -1,13 +1,14 @@
 // An independent Foxglove WebSocket client for labstand's live-view tests: the
 // @foxglove/ws-protocol package's FoxgloveClient over the `ws` package.
 //
-//   node client.js URL [--stall SECONDS]
+//   node client.js URL [--stall SECONDS] [--latency]
 //
 // Subscribes to every advertised channel. Normally it reads until the server closes the
 // connection, then prints one JSON line: the negotiated subprotocol, the server's name,
 // and per topic the message count, the log times and, for JSON topics, the decoded
 // messages' `seq` and `t_ns`. With --stall it subscribes, then stops reading from its
-// socket (a viewer that hangs) for SECONDS, and exits.
+// socket (a viewer that hangs) for SECONDS, and exits. With --latency it also reports
+// the wall time each message arrived (ns, `recvNs`), for benchmarks/bench_live.py.
 "use strict";
 const { FoxgloveClient } = require("@foxglove/ws-protocol");
 const WebSocket = require("ws");
@@ -15,7 +16,9 @@ const WebSocket = require("ws");
 const url = process.argv[2];
 const stallAt = process.argv.indexOf("--stall");
 const stallS = stallAt > 0 ? Number(process.argv[stallAt + 1]) : 0;
+const latency = process.argv.includes("--latency");
 const decoder = new TextDecoder();
+const { performance } = require("perf_hooks");
 
 function connect(deadline) {
   // Offer both: ws-protocol 0.8 speaks foxglove.websocket.v1, foxglove-sdk servers
@@ -52,6 +55,7 @@ function run(ws) {
         seq: [],
         tNs: [],
         last: null,
+        recvNs: [],
       };
     }
     if (stallS > 0) {
@@ -67,6 +71,7 @@ function run(ws) {
     const topic = topics[channel.topic];
     topic.count += 1;
     topic.logTimes.push(timestamp.toString());
+    if (latency) topic.recvNs.push(Math.round((performance.timeOrigin + performance.now()) * 1e6));
     if (channel.encoding === "json") {
       const msg = JSON.parse(decoder.decode(data));
       if (msg.seq !== undefined) topic.seq.push(msg.seq);
