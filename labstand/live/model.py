@@ -26,8 +26,9 @@ __all__ = ["LiveModel", "ModelBlock"]
 class ModelBlock:
     """The model at the samples of one gauges block, and measured − model.
 
-    u is measured from the rest value of the first sample (the model starts at rest,
-    u = 0), as in ``labstand replay``.
+    The model starts at rest (u = 0); its u is given on the gauge's scale, from the
+    first sample's reading, so it plots over the measured u even if the gauge was not
+    zeroed (the residual is then as in ``labstand replay``, both u from rest).
     """
 
     u_mm: FloatArray
@@ -68,13 +69,12 @@ class LiveModel:
         x_full = np.interp(full, known_seq, known_x) if len(full) != len(seq) else x_m
         u_m, force_n = self._stream.advance(np.ascontiguousarray(x_full, dtype=np.float64))
         pick = seq - first
-        u_mm = u_m[pick] * 1e3
+        u_mm = u_m[pick] * 1e3 + self._u_rest_mm
         force = force_n[pick]
         self._next_seq, self._last_x_m = int(seq[-1]) + 1, float(x_m[-1])
-        measured_u = np.asarray(block["u_mm"], dtype=np.float64) - self._u_rest_mm
         return ModelBlock(
             u_mm,
             force,
-            measured_u - u_mm,
+            np.asarray(block["u_mm"], dtype=np.float64) - u_mm,
             np.asarray(block["force_n"], dtype=np.float64) - force,
         )

@@ -122,7 +122,8 @@ def test_residual_is_measured_minus_model(stand: StandConfig) -> None:
     block["u_mm"] = 5.0 + np.arange(10) * 0.1  # rest value 5.0 (the first sample)
     block["force_n"] = 50.0
     out = live.advance(block)
-    np.testing.assert_allclose(out.residual_u_mm, np.arange(10) * 0.1 - out.u_mm)
+    assert out.u_mm[0] == pytest.approx(5.0)  # the model on the gauge's scale
+    np.testing.assert_allclose(out.residual_u_mm, 5.0 + np.arange(10) * 0.1 - out.u_mm)
     np.testing.assert_allclose(out.residual_force_n, 50.0 - out.force_n)
     again = live.advance(block)  # the same samples again: not fed twice
     assert len(again.u_mm) == 0
