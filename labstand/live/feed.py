@@ -128,11 +128,14 @@ class LiveFeed(ClosesOnExit):
                     log.warning("live view: publishing %s failed: %s", item.kind, err)
 
     def _publish(self, item: _Item) -> None:
-        if not self._anchored and isinstance(self.publisher, _HasEpoch):
-            # log time = the wall time the first item reached the feed, then the
-            # recording's clock: each sample stamped (near) when it arrived
-            self.publisher.epoch_ns = item.wall_ns - item.t_ns
-            self._anchored = True
+        if isinstance(self.publisher, _HasEpoch):
+            # log time = the recording's time + the smallest (arrival − recording time)
+            # seen so far: each sample stamped when it could first have arrived (the
+            # least-delayed item's lower envelope, as RunClock does; it only moves earlier)
+            epoch = item.wall_ns - item.t_ns
+            if not self._anchored or epoch < self.publisher.epoch_ns:
+                self.publisher.epoch_ns = epoch
+                self._anchored = True
         if item.kind == "gauges":
             gauges, command = item.payload
             self.publisher.gauges(gauges)

@@ -113,6 +113,9 @@ class LiveServer(ClosesOnExit):
     def __init__(self, address: ViewerAddress, name: str, epoch_ns: int | None = None) -> None:
         self.address = address
         self.epoch_ns = time.time_ns() if epoch_ns is None else epoch_ns
+        if logging.getLogger().getEffectiveLevel() > logging.DEBUG:  # without -v
+            # a viewer that closes its tab is no error of the run's
+            logging.getLogger("foxglove").setLevel(logging.CRITICAL)
         self._context = foxglove.Context()
         self._listener = _Listener()
         try:

@@ -142,6 +142,7 @@ def test_play_serves_the_file_to_an_independent_client(
     assert topics["/gauges"]["tNs"] == rec.gauges["t_ns"].tolist()
     log_times = np.array([int(t) for t in topics["/gauges"]["logTimes"]], dtype=np.int64)
     assert np.all(log_times - rec.gauges["t_ns"] == log_times[0] - rec.gauges["t_ns"][0])
+    assert np.all(np.diff(log_times) == np.diff(rec.gauges["t_ns"]))  # one fixed epoch
     # the model's replay and the residual beside them; the file is the model's own
     # simulation, so the residual is tiny
     assert topics["/model"]["tNs"] == rec.gauges["t_ns"].tolist()
