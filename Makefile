@@ -54,7 +54,7 @@ lint: $(STAMP)
 test: $(STAMP) system-tools node-tools lint
 	$(BIN)/python -m pytest -q
 
-bench: $(STAMP)
+bench: $(STAMP) node-tools
 	$(BIN)/python benchmarks/bench_model.py
 	$(BIN)/python benchmarks/bench_live.py
 

@@ -87,9 +87,13 @@ def run(args: argparse.Namespace) -> int:
             print("  waiting for a client to subscribe (Ctrl-C stops)", flush=True)
             server.wait_client()
             time.sleep(SETTLE_S)
-        passes = 0
+        passes, end_ns = 0, 0
         while True:
-            server.epoch_ns = time.time_ns() - player.start_ns
+            # each pass on the wall clock, after the last (at --speed > 1 the recording's
+            # time runs ahead of the wall's)
+            start_ns = max(time.time_ns(), end_ns + 1_000_000)
+            server.epoch_ns = start_ns - player.start_ns
+            end_ns = start_ns + player.span_ns
             stats = player.play()
             passes += 1
             print(

@@ -190,3 +190,38 @@ def test_busy_port_is_bad_input(s11: Path) -> None:
     assert result.code == 2
     assert result.err.startswith(f"labstand: error: --foxglove 127.0.0.1:{port}:")
     assert len(result.err.splitlines()) == 1
+
+
+def test_loop_plays_again_later_on_the_time_axis(s11: Path, node_client: type[NodeClient]) -> None:
+    import signal
+
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "labstand", "play", str(s11), "--speed", "20", "--loop",
+         "--start", "2", "--foxglove", "0"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )  # fmt: skip
+    try:
+        assert proc.stdout is not None
+        client = node_client(read_url(proc.stdout, []))
+        passes = 0
+        for line in proc.stdout:  # until the third pass has ended
+            passes += line.startswith("  pass ")
+            if passes == 3:
+                break
+        proc.send_signal(signal.SIGINT)  # Ctrl-C ends a loop
+        report = client.finish()
+        _, err = proc.communicate(timeout=60)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
+    assert proc.returncode == 130
+    assert err.strip().splitlines()[-1] == "labstand: interrupted"
+    rec = open_recording(s11)
+    one_pass = rec.gauges["seq"][rec.gauges["t_ns"] >= 2e9].tolist()
+    seq = report["topics"]["/gauges"]["seq"]
+    assert seq[: 3 * len(one_pass)] == one_pass * 3  # from --start to the end, again
+    log_times = np.array([int(t) for t in report["topics"]["/gauges"]["logTimes"]])
+    assert np.all(np.diff(log_times) > 0)  # each pass later than the one before
