@@ -161,3 +161,24 @@ def test_a_network_address_warns(caplog: pytest.LogCaptureFixture) -> None:
     with caplog.at_level(logging.WARNING):
         parse_address("0.0.0.0:8765")
     assert "open to the network (no authentication)" in caplog.text
+
+
+def test_the_display_shows_the_viewer_drops() -> None:
+    import io
+
+    from labstand.display import PlainDisplay, RunStatus
+    from labstand.live.view import ViewerDisplay
+
+    viewer = Hanging()
+    feed = LiveFeed(viewer, None, capacity=1)
+    block = _block(np.arange(10), np.zeros(10))
+    for _ in range(5):  # one taken (hangs), one queued, three dropped
+        feed.offer_gauges(block, np.zeros(10, dtype=COMMAND_DTYPE))
+    out = io.StringIO()
+    display = ViewerDisplay(PlainDisplay(out), feed)
+    nan = float("nan")
+    display.update(RunStatus("running", 1.0, 2.0, nan, nan, nan, 2000.0, 10, 0, 0, "running"))
+    viewer.release.set()
+    feed.close()
+    assert out.getvalue().rstrip().endswith(f"viewer dropped {feed.dropped}")
+    assert feed.dropped >= 20
