@@ -14,6 +14,7 @@ import logging
 import queue
 import threading
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, Protocol, runtime_checkable
 
@@ -76,25 +77,32 @@ class LiveFeed(ClosesOnExit):
         Items the publisher failed on (logged; the feed goes on).
     published
         Gauge samples handed to the publisher.
+
+    ``wall_ns`` is the wall clock the log times are anchored on (injected in tests).
     """
 
     def __init__(
-        self, publisher: Publisher, model: LiveModel | None, capacity: int = QUEUE_ITEMS
+        self,
+        publisher: Publisher,
+        model: LiveModel | None,
+        capacity: int = QUEUE_ITEMS,
+        wall_ns: Callable[[], int] = time.time_ns,
     ) -> None:
         self.publisher = publisher
         self.model = model
         self.dropped = 0
         self.failures = 0
         self.published = 0
+        self._wall_ns = wall_ns
         self._queue: queue.Queue[_Item | None] = queue.Queue(maxsize=capacity)
         self._stop = threading.Event()
-        self._anchored = False
+        self._anchored: str | None = None  # what set the log times' epoch
         self._thread = threading.Thread(target=self._run, name="foxglove viewer", daemon=True)
         self._thread.start()
 
     # ---- the acquisition's side: never blocks ------------------------------------
     def _offer(self, kind: str, payload: Any, t_ns: int, count: int) -> None:
-        item = _Item(kind, payload, t_ns, time.time_ns())
+        item = _Item(kind, payload, t_ns, self._wall_ns())
         try:
             self._queue.put_nowait(item)
         except queue.Full:
@@ -127,15 +135,25 @@ class LiveFeed(ClosesOnExit):
                 if self.failures <= 3:
                     log.warning("live view: publishing %s failed: %s", item.kind, err)
 
+    def _anchor(self, publisher: _HasEpoch, item: _Item) -> None:
+        """Log time = the recording's time + the smallest (arrival − recording time).
+
+        Gauge blocks set it (their times are the front end's clock): each sample is
+        stamped when it could first have arrived, the least-delayed block's lower
+        envelope as ``RunClock`` takes it, so it only moves earlier. An item before the
+        first block (the operator's note) sets it for the time being.
+        """
+        epoch = item.wall_ns - item.t_ns
+        gauges = item.kind == "gauges"
+        if self._anchored is None or (
+            gauges and (self._anchored != "gauges" or epoch < publisher.epoch_ns)
+        ):
+            publisher.epoch_ns = epoch
+            self._anchored = "gauges" if gauges else "other"
+
     def _publish(self, item: _Item) -> None:
         if isinstance(self.publisher, _HasEpoch):
-            # log time = the recording's time + the smallest (arrival − recording time)
-            # seen so far: each sample stamped when it could first have arrived (the
-            # least-delayed item's lower envelope, as RunClock does; it only moves earlier)
-            epoch = item.wall_ns - item.t_ns
-            if not self._anchored or epoch < self.publisher.epoch_ns:
-                self.publisher.epoch_ns = epoch
-                self._anchored = True
+            self._anchor(self.publisher, item)
         if item.kind == "gauges":
             gauges, command = item.payload
             self.publisher.gauges(gauges)

@@ -182,3 +182,39 @@ def test_the_display_shows_the_viewer_drops() -> None:
     feed.close()
     assert out.getvalue().rstrip().endswith(f"viewer dropped {feed.dropped}")
     assert feed.dropped >= 20
+
+
+class Stamped(Hanging):
+    """A publisher with log times (``epoch_ns`` + recording time), as LiveServer."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.release.set()
+        self.epoch_ns = -1
+        self.epochs: list[int] = []
+
+    def gauges(self, block: NDArray[np.void]) -> None:
+        self.epochs.append(self.epoch_ns)
+
+    def event(self, t_ns: int, kind: str, text: str) -> None:
+        self.epochs.append(self.epoch_ns)
+
+
+def test_log_times_follow_the_least_delayed_gauge_block() -> None:
+    walls = iter([5_000, 10_000, 12_500, 12_000, 16_000])  # when each item is offered
+    viewer = Stamped()
+    feed = LiveFeed(viewer, None, wall_ns=lambda: next(walls))
+    command = np.zeros(2, dtype=COMMAND_DTYPE)
+
+    def block(t_last_ns: int) -> NDArray[np.void]:
+        out = _block(np.arange(2), np.zeros(2))
+        out["t_ns"] = [t_last_ns - 500, t_last_ns]
+        return out
+
+    feed.offer_event(0, "note", "before the first sample")  # wall 5 000: for the time being
+    feed.offer_gauges(block(1_000), command)  # arrived 9 000 after its t: the gauges rule
+    feed.offer_gauges(block(2_000), command)  # 10 500: later than the least delay
+    feed.offer_gauges(block(3_000), command)  # 9 000: as early as the first
+    feed.offer_gauges(block(8_000), command)  # 8 000: earlier, the epoch moves back
+    feed.close()
+    assert viewer.epochs == [5_000, 9_000, 9_000, 9_000, 8_000]
