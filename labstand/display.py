@@ -149,7 +149,8 @@ class LiveDisplay(Display):
             Text(f"corrupt {s.corrupt}", style=bad),
         )
         if s.viewer:
-            table.add_row(Text(s.viewer, style="yellow" if "dropped 0" not in s.viewer else ""))
+            calm = s.viewer.endswith("dropped 0")  # nothing dropped, nothing failed
+            table.add_row(Text(s.viewer, style="" if calm else "yellow"))
         return Group(self._progress, table)
 
     def _show(self, status: RunStatus) -> None:
