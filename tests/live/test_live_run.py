@@ -70,10 +70,32 @@ def test_client_receives_every_sample_and_the_model(
         assert topics[topic]["count"] == len(rec.gauges)
         assert topics[topic]["tNs"] == rec.gauges["t_ns"].tolist()
     assert topics["/model/residual"]["schemaName"] == "labstand.ModelResidual"
+    # the simulated stand runs the model itself: measured − model is the gauge noise
+    # (σ 0.02 N) and the gauges' resolution, while F swings by tens of newtons
+    assert topics["/gauges"]["maxAbs"]["force_n"] > 60
+    assert topics["/model/residual"]["maxAbs"]["force_n"] < 0.5
     assert topics["/events"]["schemaName"] == "foxglove.Log"
     assert topics["/events"]["count"] == len(rec.events_array)
     assert topics["/drive"]["count"] == len(rec.drive)
     assert topics["/command"]["count"] >= len(rec.gauges) // 10
+
+
+def test_the_residual_shows_an_effect_the_model_lacks(
+    run_process: Callable[[list[str]], RunProcess],
+    node_client: type[NodeClient],
+    tmp_path: Path,
+) -> None:
+    port = _free_port()
+    client = node_client(f"ws://127.0.0.1:{port}")
+    proc = run_process(
+        [*SHORT, "--effect", "fibre_viscoelastic", "-o", str(tmp_path / "r.mcap"),
+         "--foxglove", str(port)]
+    )  # fmt: skip
+    report = client.finish()
+    result = proc.finish()
+    assert result.code == 0, result.err
+    # a Maxwell branch in the fibre: the force departs from the baseline while it runs
+    assert report["topics"]["/model/residual"]["maxAbs"]["force_n"] > 2.0
 
 
 def test_a_stalled_client_costs_the_recording_nothing(

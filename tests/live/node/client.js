@@ -6,7 +6,8 @@
 // Subscribes to every advertised channel. Normally it reads until the server closes the
 // connection, then prints one JSON line: the negotiated subprotocol, the server's name,
 // and per topic the message count, the log times and, for JSON topics, the decoded
-// messages' `seq` and `t_ns`. With --stall it subscribes, then stops reading from its
+// messages' `seq` and `t_ns`, the last message, and the largest magnitude of each
+// numeric field (`maxAbs`). With --stall it subscribes, then stops reading from its
 // socket (a viewer that hangs) for SECONDS, and exits. With --latency it also reports
 // the wall time each message arrived (ns, `recvNs`), for benchmarks/bench_live.py.
 "use strict";
@@ -56,6 +57,7 @@ function run(ws) {
         tNs: [],
         last: null,
         recvNs: [],
+        maxAbs: {},
       };
     }
     if (stallS > 0) {
@@ -77,6 +79,11 @@ function run(ws) {
       if (msg.seq !== undefined) topic.seq.push(msg.seq);
       if (msg.t_ns !== undefined) topic.tNs.push(msg.t_ns);
       topic.last = msg;
+      for (const [key, value] of Object.entries(msg)) {
+        if (typeof value === "number") {
+          topic.maxAbs[key] = Math.max(topic.maxAbs[key] ?? 0, Math.abs(value));
+        }
+      }
     }
   });
   client.on("close", () => {
