@@ -8,7 +8,7 @@ STAMP := $(VENV)/.installed
 OUT := out
 SYSTEM_TOOLS := mbpoll socat h5dump
 
-.PHONY: demo test lint system-tools lock bench clean
+.PHONY: demo test lint system-tools node-tools lock bench clean
 
 $(STAMP): pyproject.toml requirements.lock
 	$(PYTHON) -m venv $(VENV)
@@ -36,21 +36,31 @@ system-tools:
 	  apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq mbpoll socat hdf5-tools >/dev/null; \
 	fi
 
+# The independent Foxglove WebSocket client of the live-view tests (@foxglove/ws-protocol,
+# in Node; versions pinned by tests/live/node/package-lock.json).
+NODE_CLIENT := tests/live/node
+node-tools:
+	@command -v npm >/dev/null || { echo "installing Node.js for the tests"; \
+	  apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq nodejs npm >/dev/null; }
+	@[ -d $(NODE_CLIENT)/node_modules/@foxglove/ws-protocol ] || \
+	  npm ci --prefix $(NODE_CLIENT) --no-audit --no-fund --silent
+
 lint: $(STAMP)
 	$(BIN)/ruff check .
 	$(BIN)/ruff format --check .
 	$(BIN)/mypy
 	$(BIN)/lint-imports
 
-test: $(STAMP) system-tools lint
+test: $(STAMP) system-tools node-tools lint
 	$(BIN)/python -m pytest -q
 
-bench: $(STAMP)
+bench: $(STAMP) node-tools
 	$(BIN)/python benchmarks/bench_model.py
+	$(BIN)/python benchmarks/bench_live.py
 
 lock: $(STAMP)
 	$(BIN)/python -m pip freeze --exclude-editable | grep -v '^labstand' > requirements.lock.new
 	mv requirements.lock.new requirements.lock
 
 clean:
-	rm -rf $(VENV) $(OUT) .pytest_cache .mypy_cache .ruff_cache
+	rm -rf $(VENV) $(OUT) .pytest_cache .mypy_cache .ruff_cache $(NODE_CLIENT)/node_modules

@@ -28,6 +28,7 @@ COMMANDS = [
     "stand_sim",
     "run",
     "replay",
+    "play",
     "compare",
     "table1",
     "info",

@@ -5,7 +5,8 @@ Topics (docs/recording-format.md):
 ========================  ==========================  ======================================
 topic                     message                     rate
 ========================  ==========================  ======================================
-``/gauges``               ``GaugeBatch``              batches of ≤ ``batch_samples`` samples
+``/gauges``               ``GaugeBatch``              batches of ≤ ``batch_samples`` samples,
+                                                      each with its time in s (``t_s``)
 ``/command``              ``CommandBatch``            batches, as ``/gauges``
 ``/gauges/plot``          ``GaugeSample``             one sample per message, decimated to
                                                       ``plot_rate_hz`` (for Foxglove's plot)
@@ -65,6 +66,11 @@ TOPICS = {
 }
 GAUGE_CODEC = BatchCodec("GaugeBatch", GAUGES_DTYPE)
 COMMAND_CODEC = BatchCodec("CommandBatch", COMMAND_DTYPE)
+#: The batches as written before the derived per-sample ``t_s`` (time_s=False).
+_PLAIN_CODECS = (
+    BatchCodec("GaugeBatch", GAUGES_DTYPE, derived=False),
+    BatchCodec("CommandBatch", COMMAND_DTYPE, derived=False),
+)
 
 PLOT_CODEC = FixedCodec("GaugeSample")
 DRIVE_CODEC = FixedCodec("DriveState")
@@ -110,6 +116,10 @@ class McapRecordingWriter(RecordingWriter):
         Samples per ``/gauges`` and ``/command`` message.
     plot_rate_hz
         Rate of the decimated ``/gauges/plot`` channel, Hz; 0 leaves it out.
+    time_s
+        Give every batched sample its time in s (``t_s``), so Foxglove's Plot panel
+        draws the batches at full rate (x-axis "Message path" ``/gauges.t_s[:]``);
+        False writes the layout before it (readers need neither).
     """
 
     suffixes = (".mcap",)
@@ -121,8 +131,12 @@ class McapRecordingWriter(RecordingWriter):
         flush_interval_s: float = 0.5,
         batch_samples: int = 1000,
         plot_rate_hz: float = 100.0,
+        time_s: bool = True,
     ) -> None:
         super().__init__(path, metadata, flush_interval_s)
+        self._gauge_codec, self._command_codec = (
+            (GAUGE_CODEC, COMMAND_CODEC) if time_s else _PLAIN_CODECS
+        )
         self._start_ns = metadata.start_time_ns
         self._file: BinaryIO = open(self.path, "wb")  # noqa: SIM115 (closed in _close)
         self._writer = Writer(self._file, chunk_size=8 * 2**20, compression=CompressionType.ZSTD)
@@ -192,7 +206,7 @@ class McapRecordingWriter(RecordingWriter):
             self._writer.add_message(channel, log_time, codec.encode(batch), log_time)
 
     def _write_gauges(self, block: NDArray[np.void]) -> None:
-        self._emit("/gauges", GAUGE_CODEC, self._gauges.add(block))
+        self._emit("/gauges", self._gauge_codec, self._gauges.add(block))
         if self._plot_step:
             self._write_plot(block)
 
@@ -216,7 +230,7 @@ class McapRecordingWriter(RecordingWriter):
         self._writer.flush()  # type: ignore[no-untyped-call]
 
     def _write_command(self, block: NDArray[np.void]) -> None:
-        self._emit("/command", COMMAND_CODEC, self._command.add(block))
+        self._emit("/command", self._command_codec, self._command.add(block))
 
     def _write_drive(self, block: NDArray[np.void]) -> None:
         channel = self._channels["/drive"]
@@ -232,16 +246,16 @@ class McapRecordingWriter(RecordingWriter):
         )
 
     def _flush(self) -> None:
-        self._emit("/gauges", GAUGE_CODEC, self._gauges.take())
-        self._emit("/command", COMMAND_CODEC, self._command.take())
+        self._emit("/gauges", self._gauge_codec, self._gauges.take())
+        self._emit("/command", self._command_codec, self._command.take())
         # closes the chunk, writes it and its message index, flushes the file
         self._writer.flush()  # type: ignore[no-untyped-call]
         self._emit_plot()
 
     def _close(self) -> None:
         try:
-            self._emit("/gauges", GAUGE_CODEC, self._gauges.take())
-            self._emit("/command", COMMAND_CODEC, self._command.take())
+            self._emit("/gauges", self._gauge_codec, self._gauges.take())
+            self._emit("/command", self._command_codec, self._command.take())
             self._writer.flush()  # type: ignore[no-untyped-call]
             self._emit_plot()
             self._writer.finish()  # type: ignore[no-untyped-call]

@@ -22,6 +22,7 @@ from recordings.errors import CorruptRecordingError
 
 __all__ = [
     "COMMAND_BATCH",
+    "DERIVED",
     "DRIVE_STATE",
     "EVENT",
     "GAUGE_BATCH",
@@ -58,8 +59,13 @@ _MESSAGES: dict[str, list[tuple[str, str, bool]]] = {
         ("u_mm", "double", True),
         ("force_n", "double", True),
         ("flags", "fixed32", True),
+        ("t_s", "double", True),  # derived: t_ns / 1e9, for Foxglove's plot (§2)
     ],
-    "CommandBatch": [("t_ns", "sfixed64", True), ("x_cmd_mm", "double", True)],
+    "CommandBatch": [
+        ("t_ns", "sfixed64", True),
+        ("x_cmd_mm", "double", True),
+        ("t_s", "double", True),  # derived, as in GaugeBatch
+    ],
     "GaugeSample": [
         ("seq", "sfixed64", False),
         ("t_ns", "sfixed64", False),
@@ -125,6 +131,10 @@ def _varint(value: int) -> bytes:
             return bytes(out)
 
 
+#: Batch fields computed from others when writing, never read back.
+DERIVED = {"t_s": "t_ns"}
+
+
 class BatchCodec:
     """Encode/decode one batch message from/to a structured array with matching fields.
 
@@ -133,14 +143,20 @@ class BatchCodec:
     name
         Message name in ``_MESSAGES`` (``GaugeBatch`` or ``CommandBatch``).
     dtype
-        The stream's numpy dtype; every message field must be one of its fields.
+        The stream's numpy dtype; every message field must be one of its fields, but
+        the derived ``t_s`` (``t_ns`` in s), which is written, and skipped when read.
+    derived
+        Write the derived fields (False: the layout before they existed, for the
+        benchmark and the compatibility tests).
     """
 
-    def __init__(self, name: str, dtype: np.dtype[Any]) -> None:
+    def __init__(self, name: str, dtype: np.dtype[Any], derived: bool = True) -> None:
         self.name = f"{PACKAGE}.{name}"
         self.dtype = dtype
         spec = _MESSAGES[name]
-        self._fields = [(f, n, np.dtype(_WIRE_DTYPES[t])) for n, (f, t, _) in enumerate(spec, 1)]
+        fields = [(f, n, np.dtype(_WIRE_DTYPES[t])) for n, (f, t, _) in enumerate(spec, 1)]
+        self._fields = [f for f in fields if f[0] not in DERIVED]
+        self._derived = [f for f in fields if f[0] in DERIVED] if derived else []
         self._numbers = {n: (f, wire) for f, n, wire in self._fields}
 
     def encode(self, block: NDArray[np.void]) -> bytes:
@@ -150,6 +166,9 @@ class BatchCodec:
             return b""
         for fname, number, wire in self._fields:
             raw = np.ascontiguousarray(block[fname], dtype=wire).tobytes()
+            parts += [_varint(number << 3 | 2), _varint(len(raw)), raw]
+        for fname, number, wire in self._derived:  # t_s = t_ns / 1e9
+            raw = (block[DERIVED[fname]] / 1e9).astype(wire).tobytes()
             parts += [_varint(number << 3 | 2), _varint(len(raw)), raw]
         return b"".join(parts)
 

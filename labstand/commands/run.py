@@ -22,12 +22,13 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from types import FrameType
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from drivers.signals import SignalSpec, plan_motion
 from labstand.commands.common import add_stand_options, config_with_mass, load_stand
 from labstand.commands.simulate import add_signal_options, signal_from_args
 from labstand.errors import CommandError, ExitCode
+from labstand.live.address import ViewerAddress, parse_address
 from labstand.session import (
     Outcome,
     Preflight,
@@ -44,6 +45,9 @@ from recordings.base import FORMATS, open_writer
 from recordings.schema import Effect, RecordingMetadata, make_metadata
 from sim.config import StandConfig
 from sim.effects import EffectSpec, parse_effects
+
+if TYPE_CHECKING:
+    from labstand.live.view import LiveView
 
 
 def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -92,6 +96,12 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
             default=getattr(defaults, name),
             help=f"{what}, {unit} (default {getattr(defaults, name):g})",
         )
+    parser.add_argument(
+        "--foxglove",
+        metavar="[HOST:]PORT",
+        help="serve the run live to Foxglove (WebSocket) on PORT, on 127.0.0.1 unless a "
+        "HOST is given (docs/live-view.md); 0 picks a free port",
+    )
     # for tests: faults injected by the simulated stand (sim/hardware/faults.py)
     parser.add_argument("--sim-fault", action="append", default=[], help=argparse.SUPPRESS)
     parser.set_defaults(func=run)
@@ -123,6 +133,7 @@ class _Plan:
     effects: list[EffectSpec]
     safety: SafetyLimits
     confirm: bool
+    viewer: ViewerAddress | None
 
 
 def _check(args: argparse.Namespace) -> _Plan:
@@ -160,7 +171,8 @@ def _check(args: argparse.Namespace) -> _Plan:
             "at the stand a run must be confirmed, and there is no terminal to ask on: give --yes",
             ExitCode.REFUSED,
         )
-    return _Plan(config, spec, mass, backend, effects, safety, confirm)
+    viewer = parse_address(args.foxglove) if args.foxglove is not None else None
+    return _Plan(config, spec, mass, backend, effects, safety, confirm, viewer)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -168,6 +180,21 @@ def run(args: argparse.Namespace) -> int:
     if not args.verbose:  # its time-outs are reported by the drive driver, once
         logging.getLogger("pymodbus").setLevel(logging.CRITICAL)
     plan = _check(args)
+    with contextlib.ExitStack() as stack:
+        live = None
+        if plan.viewer is not None:  # before any device: a busy port is bad input (2)
+            from labstand.live.view import LiveView
+
+            params = plan.config.stand_params("final", plan.mass_kg)
+            live = stack.enter_context(
+                LiveView.open(plan.viewer, "labstand run", params, plan.config.sample_rate_hz)
+            )
+            _say(f"live view: {live.describe()}")
+        return _run_devices(args, plan, live)
+
+
+def _run_devices(args: argparse.Namespace, plan: _Plan, live: LiveView | None) -> int:
+    """Open the devices, run the session, report."""
     devices = open_devices(
         plan.backend,
         plan.config,
@@ -180,18 +207,29 @@ def run(args: argparse.Namespace) -> int:
         title = _title(args, plan.spec, plan.mass_kg)
         _say(f"labstand run: {title}")
         _say(f"  {plan.backend}: {devices.where}")
-        session = Session(devices.drive, devices.gauges, plan.safety, make_display(sys.stdout))
+        display = make_display(sys.stdout)
+        if live is not None:
+            display = live.display(display)
+        session = Session(devices.drive, devices.gauges, plan.safety, display)
         try:
-            result = _session(session, devices, plan, args, title)
+            result = _session(session, devices, plan, args, title, live)
         finally:
             session.shutdown()
     finally:
         devices.close()
+    if live is not None:
+        live.feed.close()  # publish what is queued, so the counts are final
+        _say(f"  live view: {live.feed.published} samples published, {live.feed.summary()}")
     return _report(result, args.output, devices.sim_summary)
 
 
 def _session(
-    session: Session, devices: Devices, plan: _Plan, args: argparse.Namespace, title: str
+    session: Session,
+    devices: Devices,
+    plan: _Plan,
+    args: argparse.Namespace,
+    title: str,
+    live: LiveView | None,
 ) -> RunResult:
     """Pre-flight, summary, confirmation, prepare, then the recorded run."""
     try:
@@ -220,7 +258,7 @@ def _session(
             effects=tuple(Effect(e.name, e.resolved()) for e in plan.effects),
             operator_note=args.note,
         )
-        return _record(session, devices, metadata, args, stop, title)
+        return _record(session, devices, metadata, args, stop, title, live)
 
 
 def _record(
@@ -230,9 +268,11 @@ def _record(
     args: argparse.Namespace,
     stop: StopRequest,
     title: str,
+    live: LiveView | None,
 ) -> RunResult:
     """The run itself, recording into the output; the file is closed on every path."""
-    pipe = RecordingPipe(open_writer(args.output, metadata))
+    writer = open_writer(args.output, metadata)
+    pipe = RecordingPipe(writer) if live is None else live.pipe(writer)
     try:
         if args.note:
             pipe.put_event(0, "note", args.note)

@@ -76,6 +76,12 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
         help="for tests: inject a fault T s after the drive starts a profile: trip, "
         "gauges-silent, garbage, modbus-mute (sim/hardware/faults.py; repeatable)",
     )
+    parser.add_argument(
+        "--foxglove",
+        metavar="[HOST:]PORT",
+        help="serve what the simulated gauges measure, and the baseline model beside it, "
+        "to Foxglove on PORT (127.0.0.1 unless a HOST is given; docs/live-view.md)",
+    )
     parser.add_argument("--json", action="store_true", help="print the endpoints as one JSON line")
     parser.add_argument(
         "--parent-pid",
@@ -157,10 +163,28 @@ def run_stand_sim(args: argparse.Namespace) -> int:
     stand = SimulatedStand.from_config(
         config, args.params, args.mass_kg, settings, ScaledClock(args.speed)
     )
-    try:
-        asyncio.run(_serve(stand, args))
-    finally:
-        summary = stand.summary()
-        if args.json:
-            _say(json.dumps({"event": "stopped", **summary}))
+    with contextlib.ExitStack() as stack:
+        if args.foxglove is not None:
+            from labstand.live.address import parse_address
+            from labstand.live.standsim import FrontEndTap
+            from labstand.live.view import LiveView
+
+            params = config.stand_params(args.params, args.mass_kg)
+            live = stack.enter_context(
+                LiveView.open(
+                    parse_address(args.foxglove),
+                    "labstand stand-sim",
+                    params,
+                    settings.frontend.rate_hz,
+                )
+            )
+            stand.frontend.tap = FrontEndTap(live.feed)
+            # with --json, stdout carries only the JSON lines
+            _say(f"live view: {live.describe()}", sys.stderr if args.json else None)
+        try:
+            asyncio.run(_serve(stand, args))
+        finally:
+            summary = stand.summary()
+            if args.json:
+                _say(json.dumps({"event": "stopped", **summary}))
     return 0

@@ -41,6 +41,8 @@ class RunStatus:
         Samples recorded; frames lost (sequence gaps) and corrupt sections so far.
     drive
         The drive's state in a few words.
+    viewer
+        The live viewer's counts (``labstand.live``), empty without one.
     """
 
     phase: str
@@ -54,6 +56,7 @@ class RunStatus:
     lost: int
     corrupt: int
     drive: str
+    viewer: str = ""
 
 
 class Display(ClosesOnExit):
@@ -84,6 +87,7 @@ def status_line(s: RunStatus) -> str:
         f"{s.phase:8s} t {s.elapsed_s:6.1f}/{s.total_s:.1f} s  x {s.x_mm:7.2f} mm  "
         f"u {s.u_mm:7.2f} mm  F {s.force_n:7.1f} N  {s.rate_hz:6.0f} Hz  "
         f"lost {s.lost}  corrupt {s.corrupt}  drive {s.drive}"
+        + (f"  {s.viewer}" if s.viewer else "")
     )
 
 
@@ -144,6 +148,9 @@ class LiveDisplay(Display):
             Text(f"lost {s.lost}", style=bad),
             Text(f"corrupt {s.corrupt}", style=bad),
         )
+        if s.viewer:
+            calm = s.viewer.endswith("dropped 0")  # nothing dropped, nothing failed
+            table.add_row(Text(s.viewer, style="" if calm else "yellow"))
         return Group(self._progress, table)
 
     def _show(self, status: RunStatus) -> None:

@@ -67,6 +67,20 @@ class FrontEndSettings:
     clock_start_us: int = 0
 
 
+class SampleTap(Protocol):
+    """Receives each block the front end measures: seq, device µs, x mm, u mm, F N, flags."""
+
+    def __call__(
+        self,
+        seq: NDArray[np.int64],
+        t_us: NDArray[np.int64],
+        x_mm: FloatArray,
+        u_mm: FloatArray,
+        force_n: FloatArray,
+        flags: NDArray[np.uint8],
+    ) -> None: ...
+
+
 class GaugeFrontEnd:
     """Turns drive positions into frames, sample by sample."""
 
@@ -82,6 +96,9 @@ class GaugeFrontEnd:
         self._rng = np.random.default_rng(self.settings.seed)
         self.produced = 0  # frames produced (sent or dropped)
         self.overrun_pending = False
+        #: Called with every block the front end measures, before it is framed (for a
+        #: live view of the simulated stand; ``labstand stand-sim --foxglove``).
+        self.tap: SampleTap | None = None
 
     def frames(self, x_m: FloatArray) -> bytes:
         """Frames for the next len(x_m) samples (x downward positive, m)."""
@@ -104,6 +121,8 @@ class GaugeFrontEnd:
             flags[0] |= FrameFlag.OVERRUN
             self.overrun_pending = False
         self.produced += n
+        if self.tap is not None:
+            self.tap(seq, t_us, np.asarray(x_m) * 1e3, u_mm, force, flags)
         return encode_frames(seq, t_us, *counts, flags=flags)
 
 
