@@ -16,12 +16,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 from drivers.closing import ClosesOnExit
-from labstand.display import Display, RunStatus
 from labstand.live.address import ViewerAddress
 from labstand.live.feed import LiveFeed
 from labstand.live.model import LiveModel
 from labstand.live.server import LiveServer
-from labstand.session_record import RecordingPipe
+from labstand.session.display import Display, RunStatus
+from labstand.session.record import RecordingPipe
 from recordings.base import RecordingWriter
 from sim.params import StandParams
 

@@ -166,8 +166,8 @@ def test_a_network_address_warns(caplog: pytest.LogCaptureFixture) -> None:
 def test_the_display_shows_the_viewer_drops() -> None:
     import io
 
-    from labstand.display import PlainDisplay, RunStatus
     from labstand.live.view import ViewerDisplay
+    from labstand.session.display import PlainDisplay, RunStatus
 
     viewer = Hanging()
     feed = LiveFeed(viewer, None, capacity=1)
