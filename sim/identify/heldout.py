@@ -86,20 +86,27 @@ def _noise_scale(rec: FloatArray, noise: float) -> float:
 
 
 def heldout_excess(traces: Sequence[Trace], outputs: Sequence[Outputs]) -> float:
-    """Held-out rms error in units of each channel's noise, RMS over traces and channels.
+    """Held-out rms error in units of each channel's noise, pooled over traces and channels.
 
     1 is a perfect model. This is what decides between candidates: each channel counts
     by how far its error stands above its own noise (the Gaussian likelihood's
     weighting), so a precise dial gauge's systematic error is not drowned by a noisier
     channel. Pooled NRMSE diluted a gauge gain error that cut the u channels' error
     3–10× into a 6 % change, below every threshold.
+
+    Pooled as a geometric mean (the likelihood when each trace and channel has its own
+    unknown error scale): every trace and channel counts by how much a model improves
+    it, not by how large its error is. An RMS over them was the error of the worst
+    trace — a chaotic bounce that neither model follows — and a candidate that cut the
+    error threefold on three recordings out of four scored a closure of 0.18.
     """
-    ratios = []
+    logs = []
     for tr, out in zip(traces, outputs, strict=True):
         for rec, sim, noise in _test_parts(tr, out):
             scale = _noise_scale(rec, noise)
-            ratios.append(float(np.sqrt(np.mean((sim - rec) ** 2))) / scale)
-    return float(np.sqrt(np.mean(np.square(ratios))))
+            rms = float(np.sqrt(np.mean((sim - rec) ** 2)))
+            logs.append(math.log(max(rms / scale, 1e-300)))
+    return float(math.exp(np.mean(logs)))
 
 
 def cycle_improvements(

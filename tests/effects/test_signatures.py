@@ -204,6 +204,33 @@ def test_the_fibre_stays_in_its_groove_until_the_slack_reaches_the_onset(
     assert np.abs(jumping.force_n - base.force_n).max() > 1.0
 
 
+def test_the_fibre_leaves_its_groove_only_after_lying_slack_for_the_dwell(
+    stand: StandConfig,
+) -> None:
+    # Situation 11 goes slack every cycle, each episode far shorter than a second: a dwell
+    # longer than every episode keeps the seat (the baseline, bit for bit); a dwell
+    # shorter than the longest episode moves it, but later than no dwell does.
+    x, mass = situation_drive(stand, "11")
+    step = {"step_m": 1e-3, "depth_scale_m": 1e-5}
+    _, base, never = _pair(
+        stand, x, mass, EffectSpec("fibre_pulley_jump", {**step, "dwell_s": 0.9})
+    )
+    assert never.slack.any()
+    assert np.array_equal(never.u_m, base.u_m)
+    slack = base.slack.astype(int)
+    starts, ends = np.flatnonzero(np.diff(slack) == 1), np.flatnonzero(np.diff(slack) == -1)
+    longest = max(e - s for s, e in zip(starts, ends[ends > starts[0]], strict=False)) / RATE
+    dwell = 0.5 * longest
+    _, _, late = _pair(stand, x, mass, EffectSpec("fibre_pulley_jump", {**step, "dwell_s": dwell}))
+    _, _, early = _pair(stand, x, mass, EffectSpec("fibre_pulley_jump", step))
+    first_change = [int(np.argmax(np.abs(r.force_n - base.force_n) > 1e-6)) for r in (early, late)]
+    assert np.abs(late.force_n - base.force_n).max() > 1.0
+    # The jump waits for the dwell: not before the first slack sample plus the dwell.
+    first_slack = int(np.argmax(base.slack))
+    assert first_change[1] >= first_slack + round(dwell * RATE) - 1
+    assert first_change[0] < first_change[1]
+
+
 def test_every_fitting_range_lies_within_what_the_model_admits() -> None:
     from sim.effects import EFFECTS
 

@@ -81,3 +81,30 @@ def test_the_evidence_is_a_one_sided_rank_test() -> None:
     assert p_value_of_gains(np.abs(rng.normal(0.0, 1.0, 12))) < 1e-3
     assert p_value_of_gains(np.array([100.0, -1, 1, -1, 1, -1, 1, -1])) > 0.05
     assert p_value_of_gains(np.array([1.0])) == 1.0
+
+
+def test_a_trace_no_model_explains_does_not_drown_a_consistent_gain(
+    stand: StandConfig,
+) -> None:
+    # Four traces: on three the candidate's error is a third of the baseline's, on the
+    # fourth (a chaotic bounce neither model follows) both err a hundred times more, by
+    # turns better and worse. Judged per block by the error ratio, and pooled by the
+    # geometric mean, the consistent gain is evidence; the fourth trace alone is none.
+    from sim.identify.decide import compare
+    from sim.identify.heldout import Outputs
+
+    traces = _campaign(stand, [], 5) + _campaign(stand, [], 6)
+    rng = np.random.default_rng(3)
+
+    def outputs(scale: float, tr: Trace) -> Outputs:
+        return Outputs(
+            tr.u_m + rng.normal(0.0, scale * tr.noise_u_m, tr.samples),
+            tr.force_n + rng.normal(0.0, scale * tr.noise_force_n, tr.samples),
+        )
+
+    before = [outputs(6.0, tr) for tr in traces[:3]] + [outputs(600.0, traces[3])]
+    after = [outputs(2.0, tr) for tr in traces[:3]] + [outputs(600.0, traces[3])]
+    evidence = compare(traces, before, after)
+    assert evidence.accepted(9), evidence
+    alone = compare(traces[3:], before[3:], after[3:])
+    assert not alone.accepted(9), alone

@@ -40,8 +40,10 @@ def test_a_small_dial_gauge_error_stands_out_in_noise_units_not_in_pooled_nrmse(
 ) -> None:
     traces, oracle = campaign
     gained = [Outputs(o.u_m * 1.002, o.force_n) for o in oracle]
-    # A 0.2 % gain error is many times the dial gauge's noise…
-    assert heldout_excess(traces, gained) > 4 * heldout_excess(traces, oracle)
+    # A 0.2 % gain error is many times the dial gauge's noise (the u channels' error
+    # grows about sevenfold; pooled geometrically with the untouched force channels,
+    # X more than doubles)…
+    assert heldout_excess(traces, gained) > 2 * heldout_excess(traces, oracle)
     # …but pooled with the noisier force channel it hardly moves the NRMSE.
     assert heldout_error(traces, gained) < 1.15 * heldout_error(traces, oracle)
     gains = cycle_improvements(traces, gained, oracle)

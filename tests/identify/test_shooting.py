@@ -249,17 +249,24 @@ def test_string_modes_carry_over_so_a_ringing_fibre_restarts_right(
     assert errors[0] < 1.2 * errors[1]
 
 
-def test_the_pulley_seat_carries_over_so_restarts_keep_the_right_groove(
-    stand: StandConfig,
+@pytest.mark.parametrize(
+    "params",
+    [
+        {"step_m": 1.3e-4, "depth_scale_m": 3.1e-3},  # a slide, deeper slack moves it further
+        {"step_m": 1.3e-4, "depth_scale_m": 1.0e-5, "dwell_s": 0.0123},  # a snap after a dwell
+    ],
+)
+def test_the_pulley_seat_follows_the_recorded_slack_so_restarts_keep_the_right_groove(
+    stand: StandConfig, params: dict[str, float]
 ) -> None:
-    # The seat toggles between two grooves on every deep slack episode; a restart cannot
-    # see which (a tenth of a millimetre in a noisy elongation). Carried over from the
-    # previous segment's run, the true model predicts a clean recording as well as one
-    # open-loop run (a seat estimated at each restart cost 340x).
+    # The seat toggles between two grooves on slack episodes; a restart cannot see which
+    # (a tenth of a millimetre in a noisy elongation), but the recording holds every
+    # episode that moved it. Set from the recorded episodes, the true model predicts a
+    # clean recording as well as one open-loop run (a seat estimated from the elongation
+    # at each restart cost 340x).
     from sim.identify.heldout import Outputs, heldout_error
 
     effect = "fibre_pulley_jump"
-    params = {"step_m": 1.3e-4, "depth_scale_m": 3.1e-3}
     tr, _ = _trace(stand, 3.096, [EffectSpec(effect, params)])
     values = dict(BASE, **{f"{effect}.{k}": v for k, v in params.items()})
     nominal = stand.stand_params("final", 3.096)
