@@ -16,6 +16,7 @@ The one way labstand runs many campaigns or recordings at once (``diagnose-check
 
 from labstand.distributed.cluster import ClusterOptions, add_cluster_options, open_client
 from labstand.distributed.jobs import JobResult, run_jobs
+from labstand.distributed.many import run_many
 from labstand.distributed.progress import Progress
 
 __all__ = [
@@ -25,4 +26,5 @@ __all__ = [
     "add_cluster_options",
     "open_client",
     "run_jobs",
+    "run_many",
 ]

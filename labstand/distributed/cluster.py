@@ -42,6 +42,8 @@ class ClusterOptions:
 
     workers: int | None = None
     scheduler: str | None = None
+    #: Threads of each local worker's numba kernels (default: cores // workers).
+    numba_threads: int | None = None
 
     @classmethod
     def from_args(cls, args: argparse.Namespace) -> ClusterOptions:
@@ -109,7 +111,7 @@ def open_client(
         return
     cores = machine_cores()
     n = options.workers or cores
-    threads = numba_threads(n, cores)
+    threads = options.numba_threads or numba_threads(n, cores)
     dashboard = "127.0.0.1:0" if _dashboard_available() else None
     with (
         LocalCluster(

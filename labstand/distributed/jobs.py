@@ -39,6 +39,8 @@ class JobResult(Generic[R]):
     seconds: float
     #: The worker's address, or ``local`` when run in this process.
     worker: str
+    #: The job failed on its input (a ValueError: a bad recording, stand file, value).
+    bad_input: bool = False
 
     @property
     def ok(self) -> bool:
@@ -55,8 +57,8 @@ def _where() -> str:
 
 def call_job(
     fn: Callable[[T], R], item: T, threads: int | None
-) -> tuple[R | None, str | None, str | None, float, str]:
-    """Run ``fn(item)`` on a worker: (value, error, error type, seconds, worker).
+) -> tuple[R | None, str | None, str | None, float, str, bool]:
+    """Run ``fn(item)`` on a worker: (value, error, error type, seconds, worker, bad input).
 
     Every exception of the job becomes its result (not a task failure, which Dask would
     retry or re-raise here); a dying process is Dask's to retry.
@@ -70,9 +72,10 @@ def call_job(
     try:
         value = fn(item)
     except Exception as err:  # the job's failure is data, reported in its row
-        return None, str(err) or repr(err), type(err).__name__, time.perf_counter() - started, \
-            _where()  # fmt: skip
-    return value, None, None, time.perf_counter() - started, _where()
+        seconds = time.perf_counter() - started
+        message = str(err) or repr(err)
+        return None, message, type(err).__name__, seconds, _where(), isinstance(err, ValueError)
+    return value, None, None, time.perf_counter() - started, _where(), False
 
 
 def run_jobs(
@@ -109,7 +112,7 @@ def run_jobs(
         for future in as_completed(futures):
             i = index[future.key]
             try:
-                out: tuple[Any, str | None, str | None, float, str] = future.result()
+                out: tuple[Any, str | None, str | None, float, str, bool] = future.result()
                 results[i] = JobResult(keys[i], *out)
             except Exception as err:  # KilledWorker, a lost scheduler: that job's error
                 results[i] = JobResult(keys[i], None, f"{type(err).__name__}: {err}",

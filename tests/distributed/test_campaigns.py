@@ -1,0 +1,151 @@
+"""Many campaigns on a real Dask LocalCluster: same answers anywhere, faults cost little."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pandas as pd
+import psutil
+import pytest
+
+from labstand.cli import main
+from labstand.distributed import ClusterOptions, Progress, open_client, run_jobs
+from sim.effects import EFFECTS
+from tests.hardware_sim.leakcheck import gone
+
+
+def diagnose_json(
+    manifest: Path, workers: int, capsys: pytest.CaptureFixture[str], results: Path | None = None
+) -> dict[str, dict[str, object]]:
+    extra = [] if results is None else ["--results", str(results)]
+    code = main(["diagnose", "--campaigns", str(manifest), "--workers", str(workers), "--json",
+                 *extra])  # fmt: skip
+    captured = capsys.readouterr()
+    assert code == 1  # one campaign of the manifest cannot be read
+    assert "1 of 4 campaign(s) failed: broken:" in captured.err
+    return {r["name"]: r for r in json.loads(captured.out)}
+
+
+def test_a_manifest_gives_the_same_answers_on_two_workers_as_on_one(
+    manifest: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    two = diagnose_json(manifest, 2, capsys, results=tmp_path / "results")
+    assert list(two) == ["plain", "visco", "broken", "dial"]  # the manifest's order
+    # The bad campaign is reported with its error; the others were diagnosed.
+    assert two["broken"]["effect"] is None
+    assert "broken.csv" in str(two["broken"]["error"])
+    for name in ("plain", "visco", "dial"):
+        assert two[name]["effect"] in {"none", *EFFECTS}
+        assert str(two[name]["worker"]).startswith("tcp://127.0.0.1:")
+    one = diagnose_json(manifest, 1, capsys)
+    for name in ("plain", "visco", "dial"):
+        for key in ("effect", "effects", "gap_after", "heldout_error_after", "baseline_fit"):
+            assert one[name][key] == two[name][key], (name, key)
+    # The results as data: a row per campaign, and the confusion matrix.
+    table = pd.read_parquet(tmp_path / "results" / "campaigns.parquet")
+    assert list(table["name"]) == ["plain", "visco", "broken", "dial"]
+    assert table.loc[2, "error"] and pd.isna(table.loc[2, "answer"])
+    assert (table.loc[[0, 1, 3], "seconds"] > 0).all()
+    answers = [two[n]["effect"] for n in ("plain", "visco", "dial")]
+    assert list(table["answer"].iloc[[0, 1, 3]]) == answers
+    confusion = pd.read_csv(tmp_path / "results" / "confusion.csv", index_col="truth")
+    assert confusion.to_numpy().sum() == 3  # the failed campaign has no answer
+    assert confusion.loc["none", two["plain"]["effect"]] >= 1
+
+
+def test_the_check_runs_its_campaigns_on_two_workers(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # The campaigns of tests/identify's serial check (seed 11): there both are right.
+    args = ["diagnose-check", "--small", "--seed", "11", "--mass-kg", "8.131", "--effects",
+            "none", "dial_gauge_calibration", "--workers", "2", "--json",
+            "--results", str(tmp_path)]  # fmt: skip
+    assert main(args) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["cases"] == 2 and out["accuracy"] == 1.0
+    table = pd.read_parquet(tmp_path / "campaigns.parquet")
+    assert list(table["name"]) == ["none@8.131kg#0", "dial_gauge_calibration@8.131kg#0"]
+    assert list(table["answer"]) == ["none", "dial_gauge_calibration"]
+    assert table["worker"].str.startswith("tcp://127.0.0.1:").all()
+
+
+def _die_on_first_try(marker: Path) -> str:
+    """A job whose first attempt kills its worker process (as a crash or the OOM killer)."""
+    if not marker.exists():
+        marker.write_text(str(os.getpid()))
+        os._exit(1)
+    return f"done in {os.getpid()}"
+
+
+def _fail(path: Path) -> str:
+    raise ValueError(f"{path}: not a recording")
+
+
+def test_a_dead_worker_costs_its_job_a_retry_and_a_failing_job_only_itself(
+    tmp_path: Path,
+) -> None:
+    marker = tmp_path / "died"
+    progress = Progress("test", 3, quiet=True)
+    with open_client(ClusterOptions(workers=2), lambda _m: None) as (client, threads):
+        assert threads == 1 or os.cpu_count() == 1
+        results = run_jobs(
+            client,
+            lambda job: job[0](job[1]),
+            [(_die_on_first_try, marker), (_fail, tmp_path / "x.csv"), (str, "fine")],
+            ["dies", "fails", "fine"],
+            progress,
+            threads,
+        )
+    assert marker.exists()  # the first attempt ran, and its process died
+    dies, fails, fine = results
+    assert dies.ok and dies.value != f"done in {marker.read_text()}"
+    assert fails.error == f"{tmp_path / 'x.csv'}: not a recording"
+    assert fails.error_type == "ValueError" and not fails.ok
+    assert fine.value == "fine"
+    assert progress.done == 3
+
+
+def test_ctrl_c_shuts_the_cluster_down_and_leaves_no_process(manifest: Path) -> None:
+    # As at a terminal: Ctrl-C sends SIGINT to the whole foreground process group, the
+    # command and its worker processes alike.
+    process = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "labstand",
+            "diagnose",
+            "--campaigns",
+            str(manifest),
+            "--workers",
+            "2",
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+    )
+    try:
+        assert process.stderr is not None
+        line = process.stderr.readline()  # printed once the cluster is up
+        assert "local cluster: 2 worker process(es)" in line, line
+        family = psutil.Process(process.pid).children(recursive=True)
+        spawned = [p for p in family if "spawn_main" in " ".join(p.cmdline())]
+        assert len(spawned) >= 2, family  # the two workers
+        os.killpg(process.pid, signal.SIGINT)
+        _, err = process.communicate(timeout=60)
+    finally:
+        if process.poll() is None:
+            os.killpg(process.pid, signal.SIGKILL)
+            process.communicate()
+    assert process.returncode == 130, err
+    assert err.strip().splitlines()[-1] == "labstand: interrupted", err
+    deadline = time.monotonic() + 10
+    while not all(gone(p.pid) for p in family):
+        assert time.monotonic() < deadline, [p.pid for p in family if not gone(p.pid)]
+        time.sleep(0.05)
