@@ -57,13 +57,17 @@ def campaign_row(
 def confusion(rows: Sequence[Mapping[str, Any]], labels: Sequence[str] = ()) -> pd.DataFrame:
     """Counts of (truth, answer) over the rows with both; ``labels`` first, then any other."""
     known = [r for r in rows if r["truth"] is not None and r["answer"] is not None]
-    seen = [*labels]
+    seen = list(labels)
     for r in known:
         seen += [x for x in (r["truth"], r["answer"]) if x not in seen]
-    table = pd.DataFrame(0, index=pd.Index(seen, name="truth"), columns=seen)
+    counts = {(t, a): 0 for t in seen for a in seen}
     for r in known:
-        table.loc[r["truth"], r["answer"]] += 1
-    return table
+        counts[r["truth"], r["answer"]] += 1
+    return pd.DataFrame(
+        [[counts[t, a] for a in seen] for t in seen],
+        index=pd.Index(seen, name="truth"),
+        columns=pd.Index(seen, name="answer"),
+    )
 
 
 def write_results(

@@ -149,3 +149,21 @@ def test_ctrl_c_shuts_the_cluster_down_and_leaves_no_process(manifest: Path) -> 
     while not all(gone(p.pid) for p in family):
         assert time.monotonic() < deadline, [p.pid for p in family if not gone(p.pid)]
         time.sleep(0.05)
+
+
+def test_table1_and_replay_over_many_recordings(
+    manifest: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    recs = manifest.parent / "recs"
+    good = [recs / f"{name}.csv" for name in ("plain", "visco", "dial")]
+    assert main(["table1", *map(str, good), str(recs / "broken.csv"), "--workers", "2",
+                 "--json"]) == 2  # fmt: skip
+    captured = capsys.readouterr()
+    rows = json.loads(captured.out)
+    assert [r["recording"] for r in rows] == [str(p) for p in good]  # the rest, in order
+    assert captured.err.count("labstand: error: ") == 1 and "broken.csv" in captured.err
+    assert main(["replay", *map(str, good), "--workers", "2", "--json"]) == 0
+    many = json.loads(capsys.readouterr().out)
+    assert main(["replay", str(good[1]), "--json"]) == 0
+    one = json.loads(capsys.readouterr().out)
+    assert many[1] == one  # the same replay, here or on a worker
