@@ -58,8 +58,9 @@ def confusion(rows: Sequence[Mapping[str, Any]], labels: Sequence[str] = ()) -> 
     """Counts of (truth, answer) over the rows with both; ``labels`` first, then any other."""
     known = [r for r in rows if r["truth"] is not None and r["answer"] is not None]
     seen = list(labels)
-    for r in known:
-        seen += [x for x in (r["truth"], r["answer"]) if x not in seen]
+    for x in (label for r in known for label in (r["truth"], r["answer"])):
+        if x not in seen:
+            seen.append(x)
     counts = {(t, a): 0 for t in seen for a in seen}
     for r in known:
         counts[r["truth"], r["answer"]] += 1
