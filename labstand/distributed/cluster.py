@@ -104,15 +104,17 @@ def open_client(
                 f"cannot reach the Dask scheduler at {options.scheduler}: {err}"
             ) from None
         with client:
-            workers = len(client.scheduler_info(n_workers=-1).get("workers", {}))
-            where = _dashboard(client, local=False)
-            say(f"scheduler {options.scheduler}, {workers} workers; {where}")
+            info = client.scheduler_info(n_workers=-1)
+            workers = len(info.get("workers", {}))
+            # The scheduler always serves HTTP (health, metrics); the dashboard pages
+            # only with bokeh installed there.
+            where = f"dashboard {client.dashboard_link} (if the scheduler has bokeh)"
+            say(f"scheduler {options.scheduler}, {workers} worker(s) now; {where}")
             yield client, None
         return
     cores = machine_cores()
     n = options.workers or cores
     threads = options.numba_threads or numba_threads(n, cores)
-    dashboard = "127.0.0.1:0" if _dashboard_available() else None
     with (
         LocalCluster(
             n_workers=n,
@@ -120,7 +122,9 @@ def open_client(
             processes=True,
             host="127.0.0.1",
             scheduler_port=0,
-            dashboard_address=dashboard,
+            # A free loopback port: the scheduler serves HTTP even without a dashboard
+            # (its default, 8787, may be taken by another cluster).
+            dashboard_address="127.0.0.1:0",
             silence_logs=logging.ERROR,
             env={"NUMBA_NUM_THREADS": str(threads)},
         ) as cluster,
@@ -133,8 +137,8 @@ def open_client(
         yield client, threads
 
 
-def _dashboard(client: Client, local: bool = True) -> str:
-    if local and not _dashboard_available():
+def _dashboard(client: Client) -> str:
+    if not _dashboard_available():
         return "dashboard off (bokeh is not installed)"
     link = client.dashboard_link
     return f"dashboard {link}" if link else "no dashboard"

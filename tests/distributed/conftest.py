@@ -39,7 +39,7 @@ def dask_process_helpers() -> Iterator[None]:
             processes=True,
             host="127.0.0.1",
             scheduler_port=0,
-            dashboard_address=None,
+            dashboard_address="127.0.0.1:0",
             silence_logs=logging.ERROR,
         ) as cluster,  # fmt: skip
         Client(cluster) as client,

@@ -167,3 +167,50 @@ def test_table1_and_replay_over_many_recordings(
     assert main(["replay", str(good[1]), "--json"]) == 0
     one = json.loads(capsys.readouterr().out)
     assert many[1] == one  # the same replay, here or on a worker
+
+
+def test_an_existing_scheduler_runs_the_same_jobs(
+    manifest: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # As docs/scale-out.md says to start them, on loopback: `dask scheduler`, `dask worker`.
+    dask = str(Path(sys.executable).parent / "dask")
+    info = tmp_path / "scheduler.json"
+    quiet = {"stdout": subprocess.DEVNULL, "stderr": subprocess.DEVNULL}
+    command = [dask, "scheduler", "--host", "127.0.0.1", "--port", "0", "--dashboard-address",
+               "127.0.0.1:0",
+               "--scheduler-file", str(info)]  # fmt: skip
+    scheduler = subprocess.Popen(command, **quiet)
+    worker = None
+    try:
+        deadline = time.monotonic() + 60
+        while not info.exists() or not info.read_text():
+            assert time.monotonic() < deadline and scheduler.poll() is None, "no scheduler"
+            time.sleep(0.1)
+        address = json.loads(info.read_text())["address"]
+        worker = subprocess.Popen(
+            [dask, "worker", address, "--nworkers", "1", "--nthreads", "1",
+             "--host", "127.0.0.1"],
+            env={**os.environ, "NUMBA_NUM_THREADS": "1"},
+            **quiet,
+        )  # fmt: skip
+        recs = [manifest.parent / "recs" / f"{n}.csv" for n in ("plain", "visco")]
+        both = ["--scheduler", address, "--workers", "1"]
+        assert main(["table1", *map(str, recs), "--json", *both]) == 2  # refused
+        assert "--workers sizes the local cluster" in capsys.readouterr().err
+        os.environ["DASK_SCHEDULER_ADDRESS"] = address
+        try:
+            assert main(["table1", *map(str, recs)]) == 0
+        finally:
+            del os.environ["DASK_SCHEDULER_ADDRESS"]
+        captured = capsys.readouterr()
+        assert f"table1: scheduler {address}, " in captured.err
+        assert "| plain.csv |" in captured.out and "| visco.csv |" in captured.out
+        assert main(["table1", *map(str, recs), "--json", "--scheduler", address]) == 0
+        there = json.loads(capsys.readouterr().out)
+        assert main(["table1", *map(str, recs), "--json", "--workers", "2"]) == 0
+        assert json.loads(capsys.readouterr().out) == there
+    finally:
+        for process in (worker, scheduler):
+            if process is not None:
+                process.terminate()
+                process.wait(timeout=60)
