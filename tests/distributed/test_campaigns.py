@@ -204,6 +204,7 @@ def test_an_existing_scheduler_runs_the_same_jobs(
             del os.environ["DASK_SCHEDULER_ADDRESS"]
         captured = capsys.readouterr()
         assert f"table1: scheduler {address}, " in captured.err
+        assert "table1: [2/2] " in captured.err  # progress, one line per recording
         assert "| plain.csv |" in captured.out and "| visco.csv |" in captured.out
         assert main(["table1", *map(str, recs), "--json", "--scheduler", address]) == 0
         there = json.loads(capsys.readouterr().out)
