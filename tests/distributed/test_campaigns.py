@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import json
 import os
 import signal
@@ -14,6 +15,7 @@ import pandas as pd
 import psutil
 import pytest
 
+from labstand.campaigns import Campaign, diagnose_campaign, load_manifest
 from labstand.cli import main
 from labstand.distributed import ClusterOptions, Progress, open_client, run_jobs
 from sim.effects import EFFECTS
@@ -75,38 +77,40 @@ def test_the_check_runs_its_campaigns_on_two_workers(
     assert table["worker"].str.startswith("tcp://127.0.0.1:").all()
 
 
-def _die_on_first_try(marker: Path) -> str:
-    """A job whose first attempt kills its worker process (as a crash or the OOM killer)."""
+def _dies_on_first_try(marker: Path, campaign: Campaign) -> dict[str, object]:
+    """A campaign whose first attempt kills its worker process (a crash, the OOM killer)."""
     if not marker.exists():
         marker.write_text(str(os.getpid()))
         os._exit(1)
-    return f"done in {os.getpid()}"
+    return {**diagnose_campaign(campaign), "pid": os.getpid()}
 
 
-def _fail(path: Path) -> str:
-    raise ValueError(f"{path}: not a recording")
-
-
-def test_a_dead_worker_costs_its_job_a_retry_and_a_failing_job_only_itself(
-    tmp_path: Path,
+def test_a_dead_worker_costs_its_campaign_a_retry_and_a_bad_one_fails_alone(
+    manifest: Path, tmp_path: Path
 ) -> None:
     marker = tmp_path / "died"
+    plain, _, broken, _ = load_manifest(manifest)
     progress = Progress("test", 3, quiet=True)
     with open_client(ClusterOptions(workers=2), lambda _m: None) as (client, threads):
         assert threads == 1 or os.cpu_count() == 1
         results = run_jobs(
             client,
             lambda job: job[0](job[1]),
-            [(_die_on_first_try, marker), (_fail, tmp_path / "x.csv"), (str, "fine")],
-            ["dies", "fails", "fine"],
+            [(functools.partial(_dies_on_first_try, marker), plain),
+             (diagnose_campaign, broken), (str, "fine")],
+            ["plain", "broken", "fine"],
             progress,
             threads,
-        )
+        )  # fmt: skip
+        # Let the nanny finish restarting the killed worker before the cluster closes.
+        client.wait_for_workers(2, timeout=60)
     assert marker.exists()  # the first attempt ran, and its process died
     dies, fails, fine = results
-    assert dies.ok and dies.value != f"done in {marker.read_text()}"
-    assert fails.error == f"{tmp_path / 'x.csv'}: not a recording"
-    assert fails.error_type == "ValueError" and not fails.ok
+    assert dies.ok, dies.error
+    assert dies.value is not None and dies.value["name"] == "plain"
+    assert dies.value["pid"] != int(marker.read_text())  # a second process finished it
+    assert dies.value["effect"] in {"none", *EFFECTS}
+    assert not fails.ok and fails.bad_input and "broken.csv" in str(fails.error)
     assert fine.value == "fine"
     assert progress.done == 3
 
