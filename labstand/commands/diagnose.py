@@ -3,19 +3,20 @@
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import json
 import sys
 from pathlib import Path
 
-import numpy as np
-import pandas as pd
-
+from labstand.campaigns import trace_of, unique_names
+from labstand.commands.diagnose_many import run_campaigns
 from labstand.diagnosis_report import write_report
+from labstand.distributed import add_cluster_options
 from labstand.errors import CommandError, ExitCode
 from recordings import RecordingError, open_recording
 from sim.config import ConfigError, StandConfig, config_from_dict, load_config
-from sim.identify import Diagnosis, DiagnosisInputError, Trace, diagnose, make_trace
+from sim.identify import Diagnosis, DiagnosisInputError, diagnose
+
+__all__ = ["register", "run", "trace_of"]
 
 
 def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -28,8 +29,22 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
         "candidate effects explains it (judged on held-out cycles), and how far it shrinks.",
     )
     parser.add_argument(
-        "recordings", type=Path, nargs="+", help="recordings (.mcap .h5 .csv .tdms)"
+        "recordings", type=Path, nargs="*", help="recordings (.mcap .h5 .csv .tdms)"
     )
+    parser.add_argument(
+        "--campaigns",
+        type=Path,
+        metavar="FILE",
+        help="diagnose every campaign of a TOML manifest ([campaign.NAME] tables with "
+        "recordings, mass_kg, optional stand and truth), in parallel on Dask",
+    )
+    parser.add_argument(
+        "--results",
+        type=Path,
+        metavar="DIR",
+        help="with --campaigns: write the results table and the confusion matrix here",
+    )
+    add_cluster_options(parser)
     parser.add_argument(
         "--stand",
         type=Path,
@@ -64,23 +79,20 @@ def _mass_of(
     return mass, "stored in the recording"
 
 
-def trace_of(name: str, frame: pd.DataFrame, mass_kg: float) -> Trace:
-    """A recording's frame (t_s index, x_mm, u_mm, F_N) as a diagnosis trace (SI units)."""
-    for column in ("x_mm", "u_mm", "F_N"):
-        if column not in frame.columns:
-            raise DiagnosisInputError(f"{name}: the recording has no {column} channel")
-    return make_trace(
-        name,
-        np.asarray(frame.index, dtype=np.float64),
-        frame["x_mm"].to_numpy(dtype=np.float64) * 1e-3,
-        frame["u_mm"].to_numpy(dtype=np.float64) * 1e-3,
-        frame["F_N"].to_numpy(dtype=np.float64),
-        mass_kg,
-    )
-
-
 def run(args: argparse.Namespace) -> int:
-    """Read, diagnose, report."""
+    """Read, diagnose, report (or, with --campaigns, every campaign of a manifest)."""
+    if args.campaigns is not None:
+        if args.recordings or args.report is not None or args.mass_kg is not None:
+            raise CommandError(
+                "--campaigns takes the recordings, masses and stands from its manifest "
+                "(no recordings, --mass-kg or --report beside it)",
+                ExitCode.USAGE,
+            )
+        return run_campaigns(args)
+    if not args.recordings:
+        raise CommandError("no recordings given (or --campaigns FILE)", ExitCode.USAGE)
+    if args.results is not None:
+        raise CommandError("--results goes with --campaigns", ExitCode.USAGE)
     config = load_config(args.stand)
     nominal = config.stand_params(args.params)
     if args.mass_kg is not None and not args.mass_kg > 0:
@@ -96,9 +108,7 @@ def run(args: argparse.Namespace) -> int:
             traces.append(trace_of(path.name, rec.frame(), mass))
         except (RecordingError, DiagnosisInputError) as err:
             raise CommandError(str(err), ExitCode.USAGE) from None
-    names = [t.name for t in traces]
-    if len(set(names)) != len(names):
-        traces = [dataclasses.replace(t, name=f"{i}:{t.name}") for i, t in enumerate(traces)]
+    traces = unique_names(traces)
 
     def progress(message: str) -> None:
         print(f"labstand diagnose: {message}", file=sys.stderr, flush=True)

@@ -3,22 +3,45 @@
 from __future__ import annotations
 
 import argparse
+import functools
 import json
 import sys
+from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
+from drivers.signals import SignalSpec
+from labstand.campaign_table import campaign_row, write_results
 from labstand.commands.common import add_stand_options, load_stand
+from labstand.distributed import (
+    ClusterOptions,
+    JobResult,
+    Progress,
+    add_cluster_options,
+    open_client,
+    run_jobs,
+)
 from labstand.errors import CommandError, ExitCode
+from sim.config import StandConfig
 from sim.identify.check import (
     CLASSES,
     FULL_CAMPAIGN,
     MASSES_KG,
     SMALL_CAMPAIGN,
     TRUTHS,
-    run_check,
+    Case,
+    CaseSpec,
+    check_cases,
+    describe,
+    diagnose_case,
+    score,
 )
+from sim.identify.check_other import PairCase
 from sim.otherstand import OTHER_EFFECTS, OTHER_PAIRS
-from sim.otherstand.campaign import OTHER_FULL, OTHER_SMALL
+from sim.otherstand.campaign import OTHER_FULL, OTHER_SMALL, OtherRecording
+
+LABEL = "labstand diagnose-check"
 
 
 def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -71,7 +94,50 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     )
     parser.add_argument("--json", action="store_true", help="print JSON (accuracy, confusion, ...)")
     parser.add_argument("-o", "--output", type=Path, help="also write the JSON here")
+    parser.add_argument(
+        "--results",
+        type=Path,
+        metavar="DIR",
+        help="write the campaigns' table and the confusion matrix here",
+    )
+    add_cluster_options(parser)
     parser.set_defaults(func=run)
+
+
+@dataclass(frozen=True)
+class CheckSetup:
+    """What every campaign of a check shares (shipped to the workers with each job)."""
+
+    stand: StandConfig
+    campaign: tuple[tuple[str, SignalSpec], ...]
+    truth_stand: str
+    other_campaign: tuple[OtherRecording, ...]
+
+
+def check_job(setup: CheckSetup, spec: CaseSpec) -> tuple[Case | PairCase, dict[str, Any]]:
+    """The job: one blind campaign, scored; its diagnosis as JSON (runs on a worker)."""
+    case, diagnosis = diagnose_case(
+        setup.stand, spec, setup.campaign, setup.truth_stand, setup.other_campaign
+    )
+    return case, diagnosis.to_dict()
+
+
+def run_cases(
+    setup: CheckSetup, specs: Sequence[CaseSpec], options: ClusterOptions, progress: Progress
+) -> list[JobResult[tuple[Case | PairCase, dict[str, Any]]]]:
+    """Every campaign on the cluster (a single one here, unless a cluster was asked for)."""
+    job = functools.partial(check_job, setup)
+    keys = [s.name for s in specs]
+
+    def tell(r: JobResult[tuple[Case | PairCase, dict[str, Any]]]) -> str:
+        if r.value is None:
+            return f"{r.key}: FAILED: {r.error}"
+        return f"{describe(r.value[0])} on {r.worker}"
+
+    if len(specs) <= 1 and not options.explicit:
+        return run_jobs(None, job, specs, keys, progress, describe=tell)
+    with open_client(options, progress.say) as (client, threads):
+        return run_jobs(client, job, specs, keys, progress, threads, tell)
 
 
 def _pairs(args: argparse.Namespace) -> list[tuple[str, str]]:
@@ -99,19 +165,50 @@ def run(args: argparse.Namespace) -> int:
     """Run the check and report."""
     stand = load_stand(args)
     pairs = _pairs(args)
-
-    def progress(message: str) -> None:
-        print(f"labstand diagnose-check: {message}", file=sys.stderr, flush=True)
-
-    result = run_check(
-        stand, seed=args.seed, trials=args.trials, classes=args.effects, masses=args.mass_kg,
-        campaign=SMALL_CAMPAIGN if args.small else FULL_CAMPAIGN, progress=progress,
-        truth_stand=args.truth, other_campaign=OTHER_SMALL if args.small else OTHER_FULL,
-        pairs=pairs,
-    )  # fmt: skip
+    options = ClusterOptions.from_args(args)
+    setup = CheckSetup(
+        stand,
+        SMALL_CAMPAIGN if args.small else FULL_CAMPAIGN,
+        args.truth,
+        OTHER_SMALL if args.small else OTHER_FULL,
+    )
+    specs = check_cases(args.seed, args.trials, args.effects, args.mass_kg, pairs)
+    progress = Progress(LABEL, len(specs), quiet=args.json)
+    results = run_cases(setup, specs, options, progress)
+    result = score(r.value[0] for r in results if r.value is not None)
     out = result.to_dict()
     out["seed"] = args.seed
     out["truth"] = args.truth
+    failed = [r for r in results if r.value is None]
+    if failed:
+        out["failed"] = [{"name": r.key, "error": r.error, "worker": r.worker} for r in failed]
+    if args.results is not None:
+        rows = [
+            campaign_row(
+                spec.name,
+                spec.truth,
+                None if r.value is None else r.value[1],
+                r.seconds,
+                r.worker,
+                r.error,
+            )
+            for spec, r in zip(specs, results, strict=True)
+        ]
+        files = write_results(args.results, rows, CLASSES)
+        progress.say(f"wrote {', '.join(str(f) for f in files)}")
+    code = _report(args, out)
+    if failed:
+        print(
+            f"{LABEL}: {len(failed)} of {len(results)} campaign(s) failed: "
+            + "; ".join(f"{r.key}: {r.error}" for r in failed),
+            file=sys.stderr,
+        )
+        return ExitCode.FAILURE
+    return code
+
+
+def _report(args: argparse.Namespace, out: dict[str, Any]) -> int:
+    """Write -o, print the JSON or the summary."""
     if args.output is not None:
         args.output.write_text(json.dumps(out, indent=2))
     if args.json:

@@ -5,13 +5,19 @@ from __future__ import annotations
 import argparse
 import json
 from collections.abc import Mapping
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
+from labstand.distributed import add_cluster_options, run_many
+from labstand.errors import CommandError, ExitCode
 from labstand.plots import plot_replay
 from labstand.recording_stand import mass_source, params_for
 from recordings import open_recording
 from recordings.replay import replay
 from sim.metrics import ChannelMetrics
+
+LABEL = "labstand replay"
 
 
 def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -22,7 +28,13 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
         description="Feed the recording's measured drive position into the baseline model "
         "and compare simulated with recorded u, F and F − T0 (R, psi = (1 − R)^2, NRMSE).",
     )
-    parser.add_argument("recording", type=Path, help="recording (.mcap, .h5, .csv, .tdms)")
+    parser.add_argument(
+        "recordings",
+        type=Path,
+        nargs="+",
+        metavar="recording",
+        help="recording(s) (.mcap, .h5, .csv, .tdms); several are replayed in parallel on Dask",
+    )
     parser.add_argument(
         "--params",
         default="final",
@@ -43,11 +55,58 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     )
     parser.add_argument("--json", action="store_true", help="print JSON (channels.u.R, ...)")
     parser.add_argument("--plot", type=Path, metavar="PNG", help="recorded vs simulated + residual")
+    add_cluster_options(parser)
     parser.set_defaults(func=run)
+
+
+@dataclass(frozen=True)
+class ReplayJob:
+    """One recording to replay."""
+
+    recording: Path
+    params: str
+    stand: Path | None
+    mass_kg: float | None
+
+
+def replay_one(job: ReplayJob) -> dict[str, Any]:
+    """The job: a recording's replay as JSON (runs on a worker for several recordings)."""
+    recording = open_recording(job.recording)
+    params, name = params_for(recording, job.stand, job.params, job.mass_kg)
+    result = replay(recording.frame(), params)
+    return {
+        "recording": str(job.recording),
+        "params": name,
+        "mass_kg": params.mass_kg,
+        **result.to_dict(),
+    }
+
+
+def run_several(args: argparse.Namespace) -> int:
+    """Replay several recordings (JSON: a list, one object per recording)."""
+    if args.plot is not None:
+        raise CommandError("--plot takes one recording", ExitCode.USAGE)
+    jobs = [ReplayJob(p, args.params, args.stand, args.mass_kg) for p in args.recordings]
+    outs, code = run_many(args, replay_one, jobs, [str(p) for p in args.recordings], LABEL)
+    if args.json:
+        print(json.dumps(outs, indent=2))
+        return code
+    for out in outs:
+        print(f"Replay of {out['recording']} with parameters '{out['params']}', "
+              f"m = {out['mass_kg']:g} kg:")  # fmt: skip
+        print(f"  {'channel':8s} {'R':>10s} {'psi':>10s} {'NRMSE':>10s}")
+        for name, m in out["channels"].items():
+            print(f"  {name:8s} {m['R']:10.6f} {m['psi']:10.3g} {m['nrmse']:10.4f}")
+        for note in out["notes"]:
+            print(f"  note: {note}")
+    return code
 
 
 def run(args: argparse.Namespace) -> int:
     """Replay and report."""
+    if len(args.recordings) > 1 or args.scheduler is not None or args.workers is not None:
+        return run_several(args)
+    args.recording = args.recordings[0]
     recording = open_recording(args.recording)
     params, name = params_for(recording, args.stand, args.params, args.mass_kg)
     result = replay(recording.frame(), params)

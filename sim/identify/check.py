@@ -20,7 +20,8 @@ from __future__ import annotations
 import dataclasses
 import logging
 import time
-from collections.abc import Callable, Sequence
+import zlib
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -34,6 +35,7 @@ from sim.identify.check_other import PairCase, named_effects, other_campaign_tra
 from sim.identify.diagnose import diagnose
 from sim.identify.fitting import Candidate, simulate_values
 from sim.identify.heldout import Outputs, heldout_error
+from sim.identify.report import Diagnosis
 from sim.identify.shooting import dial_slope
 from sim.identify.traces import Trace, make_trace
 from sim.model import Model
@@ -191,6 +193,109 @@ def _oracle(
     return Outputs(u[0], f[0])
 
 
+@dataclass(frozen=True)
+class CaseSpec:
+    """One campaign of a check: its truth (an effect, ``none``, or two joined by ``+``).
+
+    Its random draws come from ``rng()``, seeded by the check's seed and what the campaign
+    is (truth, mass, trial), never by what ran before it or where it runs: a campaign's
+    answer is the same in a serial loop, on one worker or on a hundred.
+    """
+
+    truth: str
+    mass_kg: float
+    trial: int = 0
+    seed: int = 0
+
+    @property
+    def name(self) -> str:
+        """A unique, readable key: ``truth@massKG#trial``."""
+        return f"{self.truth}@{self.mass_kg:g}kg#{self.trial}"
+
+    @property
+    def pair(self) -> bool:
+        """Two effects at once."""
+        return "+" in self.truth
+
+    def rng(self) -> np.random.Generator:
+        """The campaign's own generator (see the class docstring)."""
+        key = [self.seed, self.trial, zlib.crc32(self.truth.encode()), round(self.mass_kg * 1e3)]
+        return np.random.default_rng(key)
+
+
+def check_cases(
+    seed: int = 0,
+    trials: int = 1,
+    classes: Sequence[str] = CLASSES,
+    masses: Sequence[float] = MASSES_KG,
+    pairs: Sequence[tuple[str, str]] = (),
+) -> list[CaseSpec]:
+    """The campaigns of a check: trials × masses × (classes, then pairs)."""
+    return [
+        CaseSpec(truth, float(mass), trial, seed)
+        for trial in range(trials)
+        for mass in masses
+        for truth in [*classes, *("+".join(p) for p in pairs)]
+    ]
+
+
+def diagnose_case(
+    stand: StandConfig,
+    spec: CaseSpec,
+    campaign: Sequence[tuple[str, SignalSpec]] = FULL_CAMPAIGN,
+    truth_stand: str = "same",
+    other_campaign: Sequence[OtherRecording] = OTHER_FULL,
+) -> tuple[Case | PairCase, Diagnosis]:
+    """Generate one campaign, diagnose it blind, and score the answer.
+
+    Returns the scored case (a ``PairCase`` for two effects) and the full diagnosis.
+    """
+    if spec.pair and truth_stand != "other":
+        raise ValueError("two-effect campaigns need the other truth stand")
+    traces, oracle, params = make_campaign(
+        stand, spec.truth, spec.mass_kg, spec.rng(), campaign,
+        truth_stand=truth_stand, other_campaign=other_campaign,
+    )  # fmt: skip
+    started = time.perf_counter()
+    d = diagnose(traces, stand.stand_params("final", spec.mass_kg))
+    seconds = time.perf_counter() - started
+    if spec.pair:
+        a, b = spec.truth.split("+")
+        return PairCase((a, b), spec.mass_kg, d.effect, named_effects(d), params, seconds), d
+    e_before = d.heldout_error_before
+    shrink = (e_before - d.heldout_error_after) / e_before if e_before > 0 else 0.0
+    e_true = heldout_error(traces, oracle)
+    oracle_shrink = (e_before - e_true) / e_before if e_before > 0 else 0.0
+    case = Case(spec.truth, spec.mass_kg, d.effect, params, shrink, oracle_shrink, seconds)
+    return case, d
+
+
+def describe(case: Case | PairCase) -> str:
+    """One progress line for a scored case."""
+    if isinstance(case, PairCase):
+        mark = "both" if case.both_named else "one" if case.one_named else "WRONG"
+        return (
+            f"m={case.mass_kg:g} kg truth {'+'.join(case.truth)}: answer {case.answer} "
+            f"(effects {case.answers}; {mark}, {case.seconds:.0f} s)"
+        )
+    mark = "ok" if case.answer == case.truth else "WRONG"
+    return (
+        f"m={case.mass_kg:g} kg truth {case.truth}: answer {case.answer} ({mark}, "
+        f"{case.seconds:.0f} s)"
+    )
+
+
+def score(cases: Iterable[Case | PairCase]) -> CheckResult:
+    """The check's result from its scored cases (in any order; kept in the given one)."""
+    result = CheckResult()
+    for case in cases:
+        if isinstance(case, PairCase):
+            result.pair_cases.append(case)
+        else:
+            result.cases.append(case)
+    return result
+
+
 def run_check(
     stand: StandConfig,
     seed: int = 0,
@@ -203,55 +308,20 @@ def run_check(
     other_campaign: Sequence[OtherRecording] = OTHER_FULL,
     pairs: Sequence[tuple[str, str]] = (),
 ) -> CheckResult:
-    """Diagnose trials × classes × masses blind campaigns and score them.
+    """Diagnose trials × classes × masses blind campaigns one after another and score them.
 
     ``truth_stand`` and ``other_campaign``: see ``make_campaign``. ``pairs`` (other truth
     only): two-effect campaigns, each at every mass, scored apart (``CheckResult.pair_cases``).
+    The same campaigns run in parallel elsewhere (``labstand.distributed``) through
+    ``check_cases``, ``diagnose_case`` and ``score``.
     """
     if pairs and truth_stand != "other":
         raise ValueError("two-effect campaigns need the other truth stand")
     say = progress or (lambda _m: None)
-    rng = np.random.default_rng(seed)
-    result = CheckResult()
-    total = trials * (len(classes) + len(pairs)) * len(masses)
-    k = 0
-    for _ in range(trials):
-        for mass in masses:
-            for truth in classes:
-                k += 1
-                traces, oracle, params = make_campaign(
-                    stand, truth, mass, rng, campaign,
-                    truth_stand=truth_stand, other_campaign=other_campaign,
-                )  # fmt: skip
-                started = time.perf_counter()
-                d = diagnose(traces, stand.stand_params("final", mass))
-                seconds = time.perf_counter() - started
-                e_before = d.heldout_error_before
-                shrink = (e_before - d.heldout_error_after) / e_before if e_before > 0 else 0.0
-                e_true = heldout_error(traces, oracle)
-                oracle_shrink = (e_before - e_true) / e_before if e_before > 0 else 0.0
-                result.cases.append(
-                    Case(truth, mass, d.effect, params, shrink, oracle_shrink, seconds)
-                )
-                mark = "ok" if d.effect == truth else "WRONG"
-                say(
-                    f"[{k}/{total}] m={mass:g} kg truth {truth}: answer {d.effect} ({mark}, "
-                    f"{seconds:.0f} s)"
-                )
-            for pair in pairs:
-                k += 1
-                traces, _, params = make_campaign(
-                    stand, "+".join(pair), mass, rng, campaign,
-                    truth_stand=truth_stand, other_campaign=other_campaign,
-                )  # fmt: skip
-                started = time.perf_counter()
-                d = diagnose(traces, stand.stand_params("final", mass))
-                seconds = time.perf_counter() - started
-                case = PairCase(pair, mass, d.effect, named_effects(d), params, seconds)
-                result.pair_cases.append(case)
-                mark = "both" if case.both_named else "one" if case.one_named else "WRONG"
-                say(
-                    f"[{k}/{total}] m={mass:g} kg truth {'+'.join(pair)}: answer {d.effect} "
-                    f"(effects {case.answers}; {mark}, {seconds:.0f} s)"
-                )
-    return result
+    specs = check_cases(seed, trials, classes, masses, pairs)
+    cases: list[Case | PairCase] = []
+    for k, spec in enumerate(specs, 1):
+        case, _ = diagnose_case(stand, spec, campaign, truth_stand, other_campaign)
+        cases.append(case)
+        say(f"[{k}/{len(specs)}] {describe(case)}")
+    return score(cases)
