@@ -14,7 +14,7 @@ from labstand.errors import CommandError, ExitCode
 from labstand.plots import plot_replay
 from labstand.recording_stand import mass_source, params_for
 from recordings import open_recording
-from recordings.replay import replay
+from recordings.replay import ReplayResult, replay
 from sim.metrics import ChannelMetrics
 
 LABEL = "labstand replay"
@@ -69,17 +69,23 @@ class ReplayJob:
     mass_kg: float | None
 
 
-def replay_one(job: ReplayJob) -> dict[str, Any]:
-    """The job: a recording's replay as JSON (runs on a worker for several recordings)."""
+def _replayed(job: ReplayJob) -> tuple[dict[str, Any], ReplayResult]:
     recording = open_recording(job.recording)
     params, name = params_for(recording, job.stand, job.params, job.mass_kg)
     result = replay(recording.frame(), params)
-    return {
+    out = {
         "recording": str(job.recording),
         "params": name,
         "mass_kg": params.mass_kg,
+        "mass_source": mass_source(recording, job.stand, job.mass_kg),
         **result.to_dict(),
     }
+    return out, result
+
+
+def replay_one(job: ReplayJob) -> dict[str, Any]:
+    """The job: a recording's replay as JSON (runs on a worker for several recordings)."""
+    return _replayed(job)[0]
 
 
 def run_several(args: argparse.Namespace) -> int:
@@ -93,7 +99,7 @@ def run_several(args: argparse.Namespace) -> int:
         return code
     for out in outs:
         print(f"Replay of {out['recording']} with parameters '{out['params']}', "
-              f"m = {out['mass_kg']:g} kg:")  # fmt: skip
+              f"m = {out['mass_kg']:g} kg ({out['mass_source']}):")  # fmt: skip
         print(f"  {'channel':8s} {'R':>10s} {'psi':>10s} {'NRMSE':>10s}")
         for name, m in out["channels"].items():
             print(f"  {name:8s} {m['R']:10.6f} {m['psi']:10.3g} {m['nrmse']:10.4f}")
@@ -107,16 +113,8 @@ def run(args: argparse.Namespace) -> int:
     if len(args.recordings) > 1 or args.scheduler is not None or args.workers is not None:
         return run_several(args)
     args.recording = args.recordings[0]
-    recording = open_recording(args.recording)
-    params, name = params_for(recording, args.stand, args.params, args.mass_kg)
-    result = replay(recording.frame(), params)
-    out = {
-        "recording": str(args.recording),
-        "params": name,
-        "mass_kg": params.mass_kg,
-        "mass_source": mass_source(recording, args.stand, args.mass_kg),
-        **result.to_dict(),
-    }
+    out, result = _replayed(ReplayJob(args.recording, args.params, args.stand, args.mass_kg))
+    name = out["params"]
     if args.plot is not None:
         plot_replay(
             args.plot,
@@ -130,7 +128,7 @@ def run(args: argparse.Namespace) -> int:
         return 0
     print(
         f"Replay of {args.recording} with parameters '{name}', "
-        f"m = {params.mass_kg:g} kg ({out['mass_source']}):"
+        f"m = {out['mass_kg']:g} kg ({out['mass_source']}):"
     )
     print_metrics(result.metrics)
     for note in result.notes:
