@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 import zstandard
 from mcap.data_stream import ReadDataStream
+from mcap.exceptions import EndOfFile, McapError
 from mcap.records import Channel, Chunk, Metadata, Schema
 from numpy.typing import NDArray
 
@@ -48,6 +49,10 @@ _RECORD = struct.Struct("<BQ")
 _MESSAGE_HEAD = struct.Struct("<HIQQ")
 _CHANNEL_ID = struct.Struct("<H")
 REQUIRED_TOPICS = ("/gauges", "/command", "/drive", "/events")
+#: A chunk may claim at most this much uncompressed data per compressed byte (zstd and lz4
+#: reach a few hundred on real data); a bit flip in the size field then cannot allocate GBs.
+MAX_CHUNK_RATIO = 1024
+MAX_CHUNK_BYTES = 2**30
 
 
 class _Walk:
@@ -117,6 +122,12 @@ class _Walk:
 
     def _decompress(self, chunk: Chunk) -> bytes:
         where = f"{self.where}: chunk {self.chunks + 1}"
+        limit = min(MAX_CHUNK_RATIO * len(chunk.data) + 2**16, MAX_CHUNK_BYTES)
+        if chunk.uncompressed_size > limit:
+            raise CorruptRecordingError(
+                f"{where}: claims {chunk.uncompressed_size} bytes uncompressed from "
+                f"{len(chunk.data)} compressed (at most {limit})"
+            )
         try:
             if chunk.compression == "zstd":
                 data = self._zstd.decompress(chunk.data, max_output_size=chunk.uncompressed_size)
@@ -128,7 +139,7 @@ class _Walk:
                 data = chunk.data
             else:
                 raise CorruptRecordingError(f"{where}: unknown compression {chunk.compression!r}")
-        except zstandard.ZstdError as err:
+        except (zstandard.ZstdError, RuntimeError) as err:  # lz4 raises RuntimeError
             raise CorruptRecordingError(f"{where}: does not decompress: {err}") from err
         if len(data) != chunk.uncompressed_size:
             raise CorruptRecordingError(
@@ -167,11 +178,12 @@ def _walk_file(path: Path, salvage: bool) -> _Walk:
             continue
         try:
             walk.record(opcode, body)
-        except (struct.error, ValueError, UnicodeDecodeError) as err:
+        except (struct.error, ValueError, UnicodeDecodeError, McapError) as err:
             if isinstance(err, CorruptRecordingError):
                 raise
+            detail = "it ends before its fields do" if isinstance(err, EndOfFile) else str(err)
             raise CorruptRecordingError(
-                f"{where}: record {opcode:#04x} at byte {pos} does not decode: {err}"
+                f"{where}: record {opcode:#04x} at byte {pos} does not decode: {detail}"
             ) from err
         pos += _RECORD.size + length
         if opcode == _DATA_END:

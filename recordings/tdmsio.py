@@ -12,24 +12,51 @@ recording's ``repairs`` says so.
 from __future__ import annotations
 
 import logging
-from collections.abc import Mapping
+import math
+import re
+import struct
+from collections.abc import Iterator, Mapping
+from contextlib import contextmanager
 from datetime import UTC, datetime
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
-from nptdms import TdmsFile
+from nptdms import TdmsFile, scaling
 from numpy.typing import NDArray
 
 from recordings.base import register_format
-from recordings.errors import CorruptRecordingError, ImportMappingError
-from recordings.foreign import FIELDS, ColumnMap, build_recording, resolve, to_unit
+from recordings.errors import (
+    CorruptRecordingError,
+    ImportMappingError,
+    RecordingError,
+    shown,
+    size_text,
+)
+from recordings.foreign import FIELDS, MAX_TIME_S, ColumnMap, build_recording, resolve, to_unit
 from recordings.recording import Recording
 from sim.config import default_config
 
 __all__ = ["read_tdms"]
 
 log = logging.getLogger(__name__)
+
+#: More NI scales than this on one channel is a damaged property, not a sensor chain.
+MAX_SCALES = 64
+_SCALE_INDEX = re.compile(r"NI_Scale\[(\d+)\]")
+#: What npTDMS raises for a damaged file (it parses with struct, numpy and dicts), and
+#: RecursionError for NI scales whose input sources form a cycle.
+_TDMS_ERRORS = (
+    ValueError,
+    KeyError,
+    IndexError,
+    TypeError,
+    OSError,
+    EOFError,
+    struct.error,
+    RecursionError,
+    OverflowError,
+)
 
 
 def _channels(tdms: Any) -> dict[str, Any]:
@@ -47,12 +74,91 @@ def _channels(tdms: Any) -> dict[str, Any]:
     return names
 
 
-def _start(channel: Any) -> datetime | None:
-    value = channel.properties.get("wf_start_time")
+def _start(name: str, channel: Any, where: str) -> datetime | None:
+    value: Any = channel.properties.get("wf_start_time")
     if value is None:
         return None
-    stamp = np.datetime64(value, "us").astype(datetime)
+    if not isinstance(value, np.datetime64 | datetime):
+        raise CorruptRecordingError(
+            f"{where}: channel {name!r} property wf_start_time is {shown(value)}, not a time stamp"
+        )
+    stamp = np.datetime64(cast(Any, value), "us").astype(datetime)  # Any: both overloads
     return stamp.replace(tzinfo=UTC) if isinstance(stamp, datetime) else None
+
+
+def _number(name: str, channel: Any, key: str, default: float | None, where: str) -> float | None:
+    """A finite numeric property (``default`` when absent)."""
+    value = channel.properties.get(key, default)
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, int | float | np.integer | np.floating):
+        raise CorruptRecordingError(
+            f"{where}: channel {name!r} property {key} is {shown(value)}, not a number"
+        )
+    number = float(value)
+    if not math.isfinite(number) or abs(number) > MAX_TIME_S:
+        raise CorruptRecordingError(
+            f"{where}: channel {name!r} property {key} = {number:g} is out of range"
+        )
+    return number
+
+
+def _check_channel(name: str, channel: Any, tdms: Any, where: str, file_size: int) -> None:
+    """What reading the channel would trip on: its size, its NI scaling, its start time."""
+    raw_size = getattr(channel.data_type, "size", None) or 1
+    if len(channel) * raw_size > file_size:
+        raise CorruptRecordingError(
+            f"{where}: channel {name!r} claims {len(channel)} values "
+            f"({size_text(len(channel) * raw_size)}), more than the file ({size_text(file_size)})"
+        )
+    props = channel.properties
+    scales = [k for k in props if k.startswith("NI_Scale[")]
+    count = props.get("NI_Number_Of_Scales", 0)
+    indexes = [int(m[1]) for k in scales if (m := _SCALE_INDEX.match(k))]
+    if not isinstance(count, int | np.integer) or not 0 <= max([count, *indexes]) <= MAX_SCALES:
+        raise CorruptRecordingError(
+            f"{where}: channel {name!r} has a broken NI scaling: NI_Number_Of_Scales = "
+            f"{shown(count)}, scale indexes up to {max(indexes, default=0)} (at most {MAX_SCALES})"
+        )
+    try:
+        group = tdms[channel.group_name]
+        scaling.get_scaling(props, group.properties, tdms.properties)
+    except (KeyError, ValueError, TypeError, IndexError) as err:
+        detail = f"no property {err}" if isinstance(err, KeyError) else str(err)
+        raise CorruptRecordingError(
+            f"{where}: channel {name!r} has a broken NI scaling: {detail}"
+        ) from err
+    _start(name, channel, where)
+
+
+class _Collect(logging.Filter):
+    """Keeps npTDMS's log records instead of letting its own handler print them."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.lines: list[str] = []
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        self.lines.append(record.getMessage())
+        return False
+
+
+@contextmanager
+def _nptdms_quiet() -> Iterator[list[str]]:
+    """npTDMS prints warnings on stderr itself (names that are not UTF-8, say); collect them.
+
+    Its own handler would print them even under an error, which must stay one line.
+    """
+    collect = _Collect()
+    names = [n for n in list(logging.root.manager.loggerDict) if n.split(".")[0] == "nptdms"]
+    loggers = [logging.getLogger(n) for n in names]
+    for logger in loggers:
+        logger.addFilter(collect)
+    try:
+        yield collect.lines
+    finally:
+        for logger in loggers:
+            logger.removeFilter(collect)
 
 
 def read_tdms(
@@ -65,16 +171,39 @@ def read_tdms(
     """Read a TDMS file into a Recording (backend ``import``); see the module docstring.
 
     ``salvage`` is accepted for the registry: unequal channel lengths are always trimmed
-    and reported, as the issue asks.
+    and reported, as the issue asks. The file's metadata is read and checked first (sizes
+    against the file's, scaling, start times); only then the mapped channels' data.
     """
     where = str(path)
     try:
-        tdms = TdmsFile.read(path)
-    except (ValueError, KeyError, OSError, EOFError) as err:
-        if isinstance(err, FileNotFoundError):
-            raise
-        raise CorruptRecordingError(f"{where}: not a readable TDMS file: {err}") from err
+        with _nptdms_quiet() as warnings, TdmsFile.open(path) as tdms:
+            recording = _read(tdms, path, mapping, stand_config)
+    except (FileNotFoundError, RecordingError):
+        raise
+    except struct.error as err:
+        raise CorruptRecordingError(
+            f"{where}: not a readable TDMS file: a segment's metadata is cut short ({err})"
+        ) from err
+    except _TDMS_ERRORS as err:
+        detail = str(err) or type(err).__name__
+        raise CorruptRecordingError(f"{where}: not a readable TDMS file: {detail}") from err
+    for line in warnings:  # shown with -v; a truncated file is reported in its repairs
+        log.debug("%s: npTDMS: %s", where, shown(line, 200))
+    return recording
+
+
+def _read(
+    tdms: Any,
+    path: Path,
+    mapping: Mapping[str, ColumnMap] | None,
+    stand_config: Mapping[str, Any] | None,
+) -> Recording:
+    where = str(path)
     channels = _channels(tdms)
+    size = path.stat().st_size
+    for name, channel in channels.items():
+        if "/" in name:  # each channel once, under its full name
+            _check_channel(name, channel, tdms, where, size)
     found = resolve(list(channels), mapping or {}, where)
     data: dict[str, NDArray[np.float64]] = {}
     lengths: dict[str, int] = {}
@@ -86,28 +215,29 @@ def read_tdms(
         data[field] = to_unit(values, str(found_unit), target, f"{where}: channel {name!r}")
         lengths[name] = len(values)
     repairs: list[str] = []
-    size = min(lengths.values())
+    n = min(lengths.values())
     if len(set(lengths.values())) > 1:
         detail = ", ".join(f"{k} {v}" for k, v in lengths.items())
         repairs.append(
             f"channels of unequal length ({detail}; a truncated file?): "
-            f"trimmed to the shortest, {size} samples"
+            f"trimmed to the shortest, {n} samples"
         )
-        data = {k: v[:size] for k, v in data.items()}
-    x_channel = channels[found["x"][0]]
+        data = {k: v[:n] for k, v in data.items()}
+    x_name = found["x"][0]
+    x_channel = channels[x_name]
     rate_hz: float | None = None
     if "time" in data:
         t_s = data.pop("time")
     else:
-        increment = x_channel.properties.get("wf_increment")
-        if increment is None or not float(increment) > 0:
+        increment = _number(x_name, x_channel, "wf_increment", None, where)
+        if increment is None or not increment > 0:
             raise ImportMappingError(
-                f"{where}: channel {found['x'][0]!r} has no wf_increment and no time channel "
+                f"{where}: channel {x_name!r} has no wf_increment and no time channel "
                 "is mapped; use --map time=CHANNEL[s]"
             )
-        rate_hz = 1.0 / float(increment)
-        offset = float(x_channel.properties.get("wf_start_offset", 0.0))
-        t_s = offset + np.arange(size, dtype=np.float64) * float(increment)
+        rate_hz = 1.0 / increment
+        offset = _number(x_name, x_channel, "wf_start_offset", 0.0, where) or 0.0
+        t_s = offset + np.arange(n, dtype=np.float64) * increment
     config = stand_config if stand_config is not None else default_config().to_dict()
     return build_recording(
         path,
@@ -115,7 +245,7 @@ def read_tdms(
         t_s,
         stand_config=config,
         rate_hz=rate_hz,
-        start=_start(x_channel),
+        start=_start(x_name, x_channel, where),
         repairs=repairs,
     )
 
