@@ -80,7 +80,8 @@ def read_csv(
         sep = max(",;\t", key=first.count)
         frame = pd.read_csv(path, sep=sep, dtype=str, skipinitialspace=True)
     except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as err:
-        raise ImportMappingError(f"{where}: not a readable CSV file: {err}") from err
+        detail = " ".join(str(err).split())  # pandas ends its messages with a newline
+        raise ImportMappingError(f"{where}: not a readable CSV file: {detail}") from err
     columns = [str(c).strip() for c in frame.columns]
     frame.columns = pd.Index(columns)
     found = resolve(columns, mapping or {}, where)

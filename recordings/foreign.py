@@ -87,7 +87,14 @@ def to_unit(values: Any, unit: str, target: str, where: str) -> Any:
     if scale is None:
         known = ", ".join(table)
         raise ImportMappingError(f"{where}: unit {unit!r} is not one of {known}")
-    return values * scale
+    with np.errstate(over="ignore", invalid="ignore"):
+        out = values * scale
+    if isinstance(out, np.ndarray) and not np.isfinite(out).all():
+        i = int(np.argmin(np.isfinite(out)))
+        raise ImportMappingError(
+            f"{where}: value {values[i]:g} {unit} at sample {i} is not a finite number of {target}"
+        )
+    return out
 
 
 def resolve(

@@ -23,6 +23,7 @@ from typing import Any, cast
 
 import numpy as np
 from nptdms import TdmsFile, scaling
+from nptdms.types import DaqMxRawData
 from numpy.typing import NDArray
 
 from recordings.base import register_format
@@ -56,6 +57,7 @@ _TDMS_ERRORS = (
     struct.error,
     RecursionError,
     OverflowError,
+    NotImplementedError,  # a data type npTDMS cannot read
 )
 
 
@@ -161,6 +163,17 @@ def _nptdms_quiet() -> Iterator[list[str]]:
             logger.removeFilter(collect)
 
 
+def _check_numeric(name: str, channel: Any, where: str) -> None:
+    """A mapped channel must hold numbers (or DAQmx raw data, which its scaling turns so)."""
+    kind = channel.data_type
+    nptype = getattr(kind, "nptype", None)
+    if kind is DaqMxRawData or (nptype is not None and np.dtype(nptype).kind in "biuf"):
+        return
+    raise ImportMappingError(
+        f"{where}: channel {name!r} holds {getattr(kind, '__name__', kind)} values, not numbers"
+    )
+
+
 def read_tdms(
     path: Path,
     *,
@@ -176,7 +189,8 @@ def read_tdms(
     """
     where = str(path)
     try:
-        with _nptdms_quiet() as warnings, TdmsFile.open(path) as tdms:
+        # Our own file object: npTDMS leaves its own open when its constructor fails.
+        with _nptdms_quiet() as warnings, path.open("rb") as f, TdmsFile.open(f) as tdms:
             recording = _read(tdms, path, mapping, stand_config)
     except (FileNotFoundError, RecordingError):
         raise
@@ -209,6 +223,7 @@ def _read(
     lengths: dict[str, int] = {}
     for field, (name, unit) in found.items():
         channel = channels[name]
+        _check_numeric(name, channel, where)
         target = FIELDS[field][0]
         found_unit = unit or channel.properties.get("unit_string") or target
         values = np.asarray(channel[:], dtype=np.float64)
