@@ -16,7 +16,7 @@ import pandas as pd
 from numpy.typing import NDArray
 
 from recordings.base import register_format
-from recordings.errors import ImportMappingError
+from recordings.errors import ImportMappingError, one_line
 from recordings.foreign import FIELDS, ColumnMap, build_recording, resolve, to_unit
 from recordings.recording import Recording
 from sim.config import default_config
@@ -80,8 +80,7 @@ def read_csv(
         sep = max(",;\t", key=first.count)
         frame = pd.read_csv(path, sep=sep, dtype=str, skipinitialspace=True)
     except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as err:
-        detail = " ".join(str(err).split())  # pandas ends its messages with a newline
-        raise ImportMappingError(f"{where}: not a readable CSV file: {detail}") from err
+        raise ImportMappingError(f"{where}: not a readable CSV file: {one_line(str(err))}") from err
     columns = [str(c).strip() for c in frame.columns]
     frame.columns = pd.Index(columns)
     found = resolve(columns, mapping or {}, where)

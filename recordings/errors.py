@@ -15,6 +15,7 @@ __all__ = [
     "TruncatedRecordingError",
     "UnknownFormatError",
     "WriterClosedError",
+    "one_line",
     "shown",
     "size_text",
 ]
@@ -76,3 +77,13 @@ def size_text(n: int) -> str:
             return f"{n} bytes" if unit == "bytes" else f"{value:.3g} {unit}"
         value /= 1000
     raise AssertionError("unreachable")
+
+
+def one_line(text: str, limit: int = 200) -> str:
+    """A library's message for ours: control characters escaped, cut to ``limit``.
+
+    npTDMS puts object paths read from the file into its messages, pandas ends them with
+    a newline; an error must stay one line on stderr.
+    """
+    clean = "".join(c if c.isprintable() else repr(c)[1:-1] for c in text.strip())
+    return clean if len(clean) <= limit else f"{clean[: limit - 3]}..."

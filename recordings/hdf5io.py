@@ -37,6 +37,7 @@ from recordings.errors import (
     RecordingError,
     SchemaVersionError,
     TruncatedRecordingError,
+    one_line,
 )
 from recordings.hdf5check import check_dataset, check_global_heaps, int_attr, text_attr
 from recordings.recording import Recording
@@ -214,14 +215,18 @@ def _open(path: Path, salvage: bool) -> tuple[h5py.File, list[str]]:
         raise
     except OSError as err:
         if "already open for write" not in str(err):
-            raise CorruptRecordingError(f"{path}: not a readable HDF5 file ({err})") from err
+            raise CorruptRecordingError(
+                f"{path}: not a readable HDF5 file ({one_line(str(err))})"
+            ) from err
     line = "the file was not closed by its writer (killed, or still recording)"
     if not salvage:
         raise TruncatedRecordingError(f"{path}: {line}; run `labstand recover {path} -o FIXED.h5`")
     try:
         return h5py.File(path, "r", swmr=True), [f"recovered: {line}"]
     except OSError as err:
-        raise CorruptRecordingError(f"{path}: {line}, and it cannot be salvaged: {err}") from err
+        raise CorruptRecordingError(
+            f"{path}: {line}, and it cannot be salvaged: {one_line(str(err))}"
+        ) from err
 
 
 def _read_stream(
@@ -240,7 +245,9 @@ def _read_stream(
     try:
         return _read_rows(ds, dtype)
     except OSError as err:  # a chunk that fails its filter (gzip) or checksum
-        raise CorruptRecordingError(f"{path}: dataset /{name} cannot be read: {err}") from err
+        raise CorruptRecordingError(
+            f"{path}: dataset /{name} cannot be read: {one_line(str(err))}"
+        ) from err
 
 
 def _read_rows(ds: h5py.Dataset, dtype: np.dtype[Any]) -> NDArray[np.void]:
@@ -273,7 +280,7 @@ def read_hdf5(path: Path, *, salvage: bool = False) -> Recording:
     except RecordingError:
         raise
     except _H5_ERRORS as err:
-        message = str(err).strip("'\"") or type(err).__name__
+        message = one_line(str(err).strip("'\"")) or type(err).__name__
         raise CorruptRecordingError(f"{path}: damaged HDF5 file: {message}") from err
 
 

@@ -26,6 +26,7 @@ from recordings.errors import (
     CorruptRecordingError,
     MissingChannelError,
     TruncatedRecordingError,
+    one_line,
 )
 from recordings.mcap_writer import (
     COMMAND_CODEC,
@@ -140,7 +141,9 @@ class _Walk:
             else:
                 raise CorruptRecordingError(f"{where}: unknown compression {chunk.compression!r}")
         except (zstandard.ZstdError, RuntimeError) as err:  # lz4 raises RuntimeError
-            raise CorruptRecordingError(f"{where}: does not decompress: {err}") from err
+            raise CorruptRecordingError(
+                f"{where}: does not decompress: {one_line(str(err))}"
+            ) from err
         if len(data) != chunk.uncompressed_size:
             raise CorruptRecordingError(
                 f"{where}: {len(data)} bytes, the header says {chunk.uncompressed_size}"
@@ -181,7 +184,8 @@ def _walk_file(path: Path, salvage: bool) -> _Walk:
         except (struct.error, ValueError, UnicodeDecodeError, McapError) as err:
             if isinstance(err, CorruptRecordingError):
                 raise
-            detail = "it ends before its fields do" if isinstance(err, EndOfFile) else str(err)
+            ended = isinstance(err, EndOfFile)
+            detail = "it ends before its fields do" if ended else one_line(str(err))
             raise CorruptRecordingError(
                 f"{where}: record {opcode:#04x} at byte {pos} does not decode: {detail}"
             ) from err

@@ -11,8 +11,10 @@ recording's ``repairs`` says so.
 
 from __future__ import annotations
 
+import io
 import logging
 import math
+import os
 import re
 import struct
 from collections.abc import Iterator, Mapping
@@ -31,6 +33,7 @@ from recordings.errors import (
     CorruptRecordingError,
     ImportMappingError,
     RecordingError,
+    one_line,
     shown,
     size_text,
 )
@@ -126,11 +129,28 @@ def _check_channel(name: str, channel: Any, tdms: Any, where: str, file_size: in
         group = tdms[channel.group_name]
         scaling.get_scaling(props, group.properties, tdms.properties)
     except (KeyError, ValueError, TypeError, IndexError) as err:
-        detail = f"no property {err}" if isinstance(err, KeyError) else str(err)
+        detail = f"no property {err}" if isinstance(err, KeyError) else one_line(str(err))
         raise CorruptRecordingError(
             f"{where}: channel {name!r} has a broken NI scaling: {detail}"
         ) from err
     _start(name, channel, where)
+
+
+class _Bounded(io.BufferedReader):
+    """A file whose ``read(n)`` asks for no more than is left in it.
+
+    npTDMS reads a string by the length the file states; a damaged length (4 GB) would
+    be allocated before the read finds the file shorter.
+    """
+
+    def __init__(self, raw: io.FileIO) -> None:
+        super().__init__(raw)
+        self._size = os.fstat(raw.fileno()).st_size
+
+    def read(self, size: int | None = -1, /) -> bytes:
+        if size is not None and size > 0:
+            size = min(size, max(self._size - self.tell(), 0))
+        return super().read(size)
 
 
 class _Collect(logging.Filter):
@@ -190,7 +210,7 @@ def read_tdms(
     where = str(path)
     try:
         # Our own file object: npTDMS leaves its own open when its constructor fails.
-        with _nptdms_quiet() as warnings, path.open("rb") as f, TdmsFile.open(f) as tdms:
+        with _nptdms_quiet() as warnings, _Bounded(io.FileIO(path)) as f, TdmsFile.open(f) as tdms:
             recording = _read(tdms, path, mapping, stand_config)
     except (FileNotFoundError, RecordingError):
         raise
@@ -199,7 +219,7 @@ def read_tdms(
             f"{where}: not a readable TDMS file: a segment's metadata is cut short ({err})"
         ) from err
     except _TDMS_ERRORS as err:
-        detail = str(err) or type(err).__name__
+        detail = one_line(str(err)) or type(err).__name__
         raise CorruptRecordingError(f"{where}: not a readable TDMS file: {detail}") from err
     for line in warnings:  # shown with -v; a truncated file is reported in its repairs
         log.debug("%s: npTDMS: %s", where, shown(line, 200))
