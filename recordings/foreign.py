@@ -89,10 +89,12 @@ def to_unit(values: Any, unit: str, target: str, where: str) -> Any:
         raise ImportMappingError(f"{where}: unit {unit!r} is not one of {known}")
     with np.errstate(over="ignore", invalid="ignore"):
         out = values * scale
-    if isinstance(out, np.ndarray) and not np.isfinite(out).all():
-        i = int(np.argmin(np.isfinite(out)))
+    # Only what the conversion overflowed; a NaN read from the file is Recording.check's.
+    overflowed = ~np.isfinite(out) & np.isfinite(values) if isinstance(out, np.ndarray) else None
+    if overflowed is not None and overflowed.any():
+        i = int(np.argmax(overflowed))
         raise ImportMappingError(
-            f"{where}: value {values[i]:g} {unit} at sample {i} is not a finite number of {target}"
+            f"{where}: value {values[i]:g} {unit} at sample {i} is too large to convert to {target}"
         )
     return out
 

@@ -11,6 +11,7 @@ recording's ``repairs`` says so.
 
 from __future__ import annotations
 
+import errno
 import io
 import logging
 import math
@@ -217,6 +218,14 @@ def read_tdms(
     except struct.error as err:
         raise CorruptRecordingError(
             f"{where}: not a readable TDMS file: a segment's metadata is cut short ({err})"
+        ) from err
+    except OSError as err:
+        if err.errno != errno.EINVAL:
+            raise CorruptRecordingError(
+                f"{where}: cannot read the TDMS file: {one_line(str(err))}"
+            ) from err
+        raise CorruptRecordingError(
+            f"{where}: not a readable TDMS file: a segment points outside the file ({err})"
         ) from err
     except _TDMS_ERRORS as err:
         detail = one_line(str(err)) or type(err).__name__
