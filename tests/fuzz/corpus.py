@@ -119,7 +119,11 @@ def write_seeds(directory: Path) -> dict[str, Path]:
 
 # -- reading --------------------------------------------------------------------------------
 def read(path: Path) -> None:
-    """What the commands do with the file: read, check, summarise (``info``), frame."""
+    """What the commands do with the file: read, check, summarise (``info``), frame.
+
+    A recording is read as ``info`` reads it and as ``recover`` does (salvaging); the
+    second read's outcome is the case's.
+    """
     if path.suffix == ".toml":
         config = load_config(path)
         for name in config.parameter_sets:
@@ -129,7 +133,11 @@ def read(path: Path) -> None:
         recording = read_tdms(path, mapping=TDMS_MAP)
         recording.check()
     else:
-        recording = open_recording(path)
+        try:
+            open_recording(path)
+        except RecordingError:
+            pass  # refused: what `labstand recover` then reads is below
+        recording = open_recording(path, salvage=True)
     summary(recording)
     recording.frame()
     recording.events()
