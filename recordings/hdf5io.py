@@ -230,7 +230,7 @@ def _open(path: Path, salvage: bool) -> tuple[h5py.File, list[str]]:
 
 
 def _read_stream(
-    h5: h5py.File, path: Path, name: str, dtype: np.dtype[Any], file_size: int
+    h5: h5py.File, path: Path, name: str, dtype: np.dtype[Any], file_size: int, repairs: list[str]
 ) -> NDArray[np.void]:
     where = str(path)
     link = h5.get(name, getlink=True)
@@ -243,26 +243,37 @@ def _read_stream(
         raise MissingChannelError(f"{path}: no dataset /{name}")
     check_dataset(ds, where, dtype, file_size)
     try:
-        return _read_rows(ds, dtype)
+        return _read_rows(ds, dtype, repairs)
     except OSError as err:  # a chunk that fails its filter (gzip) or checksum
         raise CorruptRecordingError(
             f"{path}: dataset /{name} cannot be read: {one_line(str(err))}"
         ) from err
 
 
-def _read_rows(ds: h5py.Dataset, dtype: np.dtype[Any]) -> NDArray[np.void]:
+def _read_rows(ds: h5py.Dataset, dtype: np.dtype[Any], repairs: list[str]) -> NDArray[np.void]:
     if dtype.hasobject:
         raw = ds.fields(list(dtype.names or ()))[...]
         out = np.empty(len(raw), dtype=dtype)
         for field in dtype.names or ():
             column = raw[field]
             if dtype[field] == np.dtype(object):
-                column = [v.decode(errors="replace") if isinstance(v, bytes) else v for v in column]
+                column = [_text(v, i, f"{ds.name}.{field}", repairs) for i, v in enumerate(column)]
             out[field] = column
         return out
     if ds.dtype == dtype:
         return np.asarray(ds[...])
     return np.asarray(ds.fields(list(dtype.names or ()))[...]).astype(dtype)
+
+
+def _text(value: Any, row: int, where: str, repairs: list[str]) -> Any:
+    """A string field's value; bytes that are not UTF-8 are kept, marked, and said so."""
+    if not isinstance(value, bytes):
+        return value
+    try:
+        return value.decode()
+    except UnicodeDecodeError:
+        repairs.append(f"{where} row {row} is not UTF-8: decoded with replacement characters")
+        return value.decode(errors="replace")
 
 
 #: What h5py raises for a damaged file: a failed checksum opening an object (KeyError),
@@ -295,7 +306,7 @@ def _read_open(h5: h5py.File, path: Path, repairs: list[str]) -> Recording:
     metadata = RecordingMetadata.from_json(text_attr(h5.attrs, "metadata_json", where), where)
     size = path.stat().st_size
     streams = {
-        name: _read_stream(h5, path, name, dtype, size)
+        name: _read_stream(h5, path, name, dtype, size, repairs)
         for name, dtype in (
             ("gauges", GAUGES_DTYPE),
             ("command", COMMAND_DTYPE),

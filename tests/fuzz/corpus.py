@@ -11,6 +11,7 @@ lead-in, an HDF5 attribute or dataset replaced through h5py, a TOML or CSV value
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import random
 import re
@@ -133,10 +134,8 @@ def read(path: Path) -> None:
         recording = read_tdms(path, mapping=TDMS_MAP)
         recording.check()
     else:
-        try:
+        with contextlib.suppress(RecordingError):  # refused: `labstand recover` reads on
             open_recording(path)
-        except RecordingError:
-            pass  # refused: what `labstand recover` then reads is below
         recording = open_recording(path, salvage=True)
     summary(recording)
     recording.frame()

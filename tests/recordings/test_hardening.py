@@ -129,3 +129,18 @@ def test_a_unit_conversion_that_overflows_names_the_sample(tmp_path: Path):
     assert str(info.value) == (
         f"{path}: column 'x[m]': value 1e+307 m at sample 1 is too large to convert to mm"
     )
+
+
+def test_an_event_text_that_is_not_utf8_is_read_and_said_so(tmp_path: Path, meta):
+    path = tmp_path / "run.h5"
+    _write(path, meta)
+    with h5py.File(path, "a") as f:
+        events = f["events"]
+        row = events[0]
+        row["text"] = b"a not\xff"  # a flipped bit in the heap: no longer UTF-8
+        events[0] = row
+    recording = open_recording(path)
+    assert recording.events()["text"].iloc[0] == "a not\ufffd"
+    assert recording.repairs == [
+        "/events.text row 0 is not UTF-8: decoded with replacement characters"
+    ]
