@@ -17,6 +17,10 @@ dead space behind; only ``close`` writes the last partial chunk. The file is cre
 ``libver=('v110', 'latest')`` (readable by the HDF5 1.10 tools of Debian) and switched to
 SWMR mode, so a live reader can open it and a killed writer leaves a consistent file,
 which ``open_recording(..., salvage=True)`` opens in SWMR-read mode.
+
+Reading checks the file before h5py touches what could hang it or allocate what a
+damaged header claims (``recordings.hdf5check``), and turns what h5py still raises into
+``CorruptRecordingError``.
 """
 
 from __future__ import annotations

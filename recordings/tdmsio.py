@@ -7,6 +7,10 @@ the run, UTC), ``unit_string`` (units, converted to the schema's); NI scaling pr
 are applied by npTDMS when the data is read. A truncated TDMS file (LabVIEW killed)
 loads with channels of unequal length: they are trimmed to the shortest, and the
 recording's ``repairs`` says so.
+
+A damaged file is refused before its data is read: every channel's size against the
+file's, its NI scaling and start-time properties are checked on the metadata (npTDMS's
+lazy reader), and what npTDMS still raises becomes ``CorruptRecordingError``.
 """
 
 from __future__ import annotations
