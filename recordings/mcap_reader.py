@@ -111,6 +111,8 @@ class _Walk:
         while pos < end:  # the hot loop: one pass per message, kept lean on purpose
             opcode, length = record_head(view, pos)
             stop = pos + _RECORD.size + length
+            if stop > end:
+                break  # a damaged length: "ends mid-record" below
             if opcode == _MESSAGE:
                 (channel_id,) = channel_of(view, pos + _RECORD.size)
                 if channel_id not in skip:
@@ -181,11 +183,16 @@ def _walk_file(path: Path, salvage: bool) -> _Walk:
             continue
         try:
             walk.record(opcode, body)
-        except (struct.error, ValueError, UnicodeDecodeError, McapError) as err:
+        # OverflowError: a length field near 2**64 handed to BytesIO.read or a slice
+        except (struct.error, ValueError, UnicodeDecodeError, McapError, OverflowError) as err:
             if isinstance(err, CorruptRecordingError):
                 raise
-            ended = isinstance(err, EndOfFile)
-            detail = "it ends before its fields do" if ended else one_line(str(err))
+            if isinstance(err, EndOfFile):
+                detail = "it ends before its fields do"
+            elif isinstance(err, OverflowError):
+                detail = "a length field in it is larger than any file"
+            else:
+                detail = one_line(str(err))
             raise CorruptRecordingError(
                 f"{where}: record {opcode:#04x} at byte {pos} does not decode: {detail}"
             ) from err

@@ -259,7 +259,8 @@ def _read(
         _check_numeric(name, channel, where)
         target = FIELDS[field][0]
         found_unit = unit or channel.properties.get("unit_string") or target
-        values = np.asarray(channel[:], dtype=np.float64)
+        with np.errstate(over="ignore", invalid="ignore"):  # NI scaling of damaged values
+            values = np.asarray(channel[:], dtype=np.float64)  # inf: Recording.check says
         data[field] = to_unit(values, str(found_unit), target, f"{where}: channel {name!r}")
         lengths[name] = len(values)
     repairs: list[str] = []

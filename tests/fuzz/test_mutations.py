@@ -41,6 +41,23 @@ def test_mutations_are_the_same_on_every_run(tmp_path: Path, seeds: dict[str, by
     assert all(data not in seeds.values() for data in first)
 
 
+#: (seed, case) that broke once in benchmarks/fuzz_readers.py runs: MCAP length fields near
+#: 2**64 (OverflowError), NI scaling and sums that overflow (numpy warnings). Tied to the
+#: corpus as it is: an edit to corpus.py changes which files these are.
+FOUND = [(3, 4080), (3, 7735), (3, 12858), (3, 16918)]
+
+
+@pytest.mark.parametrize(("seed", "index"), FOUND)
+def test_cases_the_benchmark_found(
+    seed: int, index: int, tmp_path: Path, seeds: dict[str, bytes]
+) -> None:
+    case = corpus.make_case(seeds, seed, index, tmp_path)
+    try:
+        corpus.read(case.path)
+    except corpus.expected_error(case.path) as err:
+        assert "\n" not in str(err) and str(case.path) in str(err)
+
+
 @pytest.mark.timeout(900, method="thread")  # a hang inside a C library ignores signals
 def test_every_mutated_file_reads_or_is_refused_in_one_line(
     tmp_path: Path, seeds: dict[str, bytes]
