@@ -82,6 +82,8 @@ Check = Callable[[Any], str | None]  # returns a complaint, or None when the val
 
 def _show(value: Any) -> str:
     """``repr`` of a value, cut short: a message stays one readable line."""
+    if isinstance(value, int) and value.bit_length() > 200:  # repr fails beyond 4300 digits
+        return f"an integer of {value.bit_length()} bits"
     text = repr(value)
     return text if len(text) <= 60 else f"{text[:57]}..."
 
@@ -366,7 +368,7 @@ def load_config(path: str | Path | None) -> StandConfig:
         raise ConfigError(f"{p}: {where}: arrays or tables nested deeper than {MAX_NESTING} levels")
     try:
         data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as err:
+    except ValueError as err:  # TOMLDecodeError, or int() of more than 4300 digits
         raise ConfigError(f"{p}: not valid TOML: {err}") from None
     if (key := _too_deep_data(data)) is not None:
         raise ConfigError(f"{p}: key {key}: tables nested deeper than {MAX_NESTING} levels")
