@@ -16,7 +16,7 @@ import pandas as pd
 from numpy.typing import NDArray
 
 from recordings.base import register_format
-from recordings.errors import ImportMappingError, one_line
+from recordings.errors import ImportMappingError, one_line, shown
 from recordings.foreign import FIELDS, ColumnMap, build_recording, resolve, to_unit
 from recordings.recording import Recording
 from sim.config import default_config
@@ -47,7 +47,7 @@ def _numeric(frame: pd.DataFrame, column: str, where: str) -> NDArray[np.float64
     if bad.any():
         i = int(np.argmax(bad))
         raise ImportMappingError(
-            f"{where}: column {column!r} line {i + 2}: not a finite number: {raw.iloc[i]!r}"
+            f"{where}: column {column!r} line {i + 2}: not a finite number: {shown(raw.iloc[i])}"
         )
     return values
 
