@@ -58,7 +58,9 @@ def check_stream(where: str, stream: str, block: NDArray[np.void], strict: bool 
     if len(block) == 0:
         return
     floats = _FLOAT_FIELDS.get(stream, ())
-    if floats and not math.isfinite(float(sum(block[name].sum() for name in floats))):
+    with np.errstate(over="ignore"):  # finite values whose sum overflows: checked one by one
+        total = float(sum(block[name].sum() for name in floats)) if floats else 0.0
+    if not math.isfinite(total):
         for name in floats:
             bad = ~np.isfinite(block[name])
             if bad.any():

@@ -22,7 +22,7 @@ from numpy.typing import NDArray
 
 from recordings.base import EVENTS_DTYPE, register_format
 from recordings.csvtext import CsvOptions, CsvText, split_csv
-from recordings.errors import CorruptRecordingError, ImportMappingError, RecordingError
+from recordings.errors import CorruptRecordingError, ImportMappingError, RecordingError, shown
 from recordings.foreign import FIELDS, ColumnMap, build_recording, resolve, to_unit
 from recordings.recording import Recording
 from recordings.schema import DRIVE_DTYPE, RecordingMetadata
@@ -78,7 +78,7 @@ def _numeric(
     if bad.any():
         i = int(np.argmax(bad))
         value = raw.iloc[i]
-        what = "empty" if pd.isna(value) else f"{str(value)!r} is not a finite number"
+        what = "empty" if pd.isna(value) else f"{shown(str(value))} is not a finite number"
         hint = ""
         if text.options.decimal == "." and "," in str(value):
             hint = " (comma decimals? use --decimal ,)"

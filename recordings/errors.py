@@ -15,6 +15,9 @@ __all__ = [
     "TruncatedRecordingError",
     "UnknownFormatError",
     "WriterClosedError",
+    "one_line",
+    "shown",
+    "size_text",
 ]
 
 
@@ -52,3 +55,35 @@ class InvalidDataError(RecordingError):
 
 class ImportMappingError(RecordingError):
     """A foreign file (CSV, TDMS) whose columns cannot be mapped onto the schema."""
+
+
+def shown(value: object, limit: int = 60) -> str:
+    """A value for a one-line message: its repr cut to ``limit`` characters.
+
+    An integer too long for ``repr`` (Python refuses more than 4300 digits) is given by
+    its size instead.
+    """
+    if isinstance(value, int) and value.bit_length() > 200:
+        return f"an integer of {value.bit_length()} bits"
+    text = repr(value)
+    return text if len(text) <= limit else f"{text[: limit - 3]}..."
+
+
+def size_text(n: int) -> str:
+    """Bytes in a short human form (``12 kB``, ``3.7 TB``)."""
+    value = float(n)
+    for unit in ("bytes", "kB", "MB", "GB", "TB"):
+        if value < 1000 or unit == "TB":
+            return f"{n} bytes" if unit == "bytes" else f"{value:.3g} {unit}"
+        value /= 1000
+    raise AssertionError("unreachable")
+
+
+def one_line(text: str, limit: int = 200) -> str:
+    """A library's message for ours: control characters escaped, cut to ``limit``.
+
+    npTDMS puts object paths read from the file into its messages, pandas ends them with
+    a newline; an error must stay one line on stderr.
+    """
+    clean = "".join(c if c.isprintable() else repr(c)[1:-1] for c in text.strip())
+    return clean if len(clean) <= limit else f"{clean[: limit - 3]}..."

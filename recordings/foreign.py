@@ -26,7 +26,10 @@ from recordings.errors import ImportMappingError
 from recordings.recording import Recording
 from recordings.schema import COMMAND_DTYPE, GAUGES_DTYPE, Backend, make_metadata
 
-__all__ = ["FIELDS", "ColumnMap", "build_recording", "parse_mapping", "to_unit"]
+__all__ = ["FIELDS", "MAX_TIME_S", "ColumnMap", "build_recording", "parse_mapping", "to_unit"]
+
+#: Times beyond ±292 years do not fit the schema's int64 nanoseconds.
+MAX_TIME_S = 9.2e9
 
 #: field -> (schema unit, default column names tried in order)
 FIELDS: dict[str, tuple[str, tuple[str, ...]]] = {
@@ -84,7 +87,16 @@ def to_unit(values: Any, unit: str, target: str, where: str) -> Any:
     if scale is None:
         known = ", ".join(table)
         raise ImportMappingError(f"{where}: unit {unit!r} is not one of {known}")
-    return values * scale
+    with np.errstate(over="ignore", invalid="ignore"):
+        out = values * scale
+    # Only what the conversion overflowed; a NaN read from the file is Recording.check's.
+    overflowed = ~np.isfinite(out) & np.isfinite(values) if isinstance(out, np.ndarray) else None
+    if overflowed is not None and overflowed.any():
+        i = int(np.argmax(overflowed))
+        raise ImportMappingError(
+            f"{where}: value {values[i]:g} {unit} at sample {i} is too large to convert to {target}"
+        )
+    return out
 
 
 def resolve(
@@ -145,6 +157,13 @@ def build_recording(
     n = len(t_s)
     if n < 2:
         raise ImportMappingError(f"{where}: needs at least 2 samples, got {n}")
+    outside = ~(np.abs(t_s) < MAX_TIME_S)
+    if outside.any():
+        i = int(np.argmax(outside))
+        raise ImportMappingError(
+            f"{where}: time {t_s[i]:g} s at sample {i} is beyond ±{MAX_TIME_S:g} s "
+            "(the schema's nanosecond clock)"
+        )
     if rate_hz is None:
         spacing = float(np.median(np.diff(t_s)))
         if not (math.isfinite(spacing) and spacing > 0):

@@ -17,6 +17,10 @@ dead space behind; only ``close`` writes the last partial chunk. The file is cre
 ``libver=('v110', 'latest')`` (readable by the HDF5 1.10 tools of Debian) and switched to
 SWMR mode, so a live reader can open it and a killed writer leaves a consistent file,
 which ``open_recording(..., salvage=True)`` opens in SWMR-read mode.
+
+Reading checks the file before h5py touches what could hang it or allocate what a
+damaged header claims (``recordings.hdf5check``), and turns what h5py still raises into
+``CorruptRecordingError``.
 """
 
 from __future__ import annotations
@@ -34,9 +38,12 @@ from recordings.base import EVENTS_DTYPE, RecordingWriter, register_format
 from recordings.errors import (
     CorruptRecordingError,
     MissingChannelError,
+    RecordingError,
     SchemaVersionError,
     TruncatedRecordingError,
+    one_line,
 )
+from recordings.hdf5check import check_dataset, check_global_heaps, int_attr, text_attr
 from recordings.recording import Recording
 from recordings.schema import (
     COMMAND_DTYPE,
@@ -212,33 +219,49 @@ def _open(path: Path, salvage: bool) -> tuple[h5py.File, list[str]]:
         raise
     except OSError as err:
         if "already open for write" not in str(err):
-            raise CorruptRecordingError(f"{path}: not a readable HDF5 file ({err})") from err
+            raise CorruptRecordingError(
+                f"{path}: not a readable HDF5 file ({one_line(str(err))})"
+            ) from err
     line = "the file was not closed by its writer (killed, or still recording)"
     if not salvage:
         raise TruncatedRecordingError(f"{path}: {line}; run `labstand recover {path} -o FIXED.h5`")
     try:
         return h5py.File(path, "r", swmr=True), [f"recovered: {line}"]
     except OSError as err:
-        raise CorruptRecordingError(f"{path}: {line}, and it cannot be salvaged: {err}") from err
+        raise CorruptRecordingError(
+            f"{path}: {line}, and it cannot be salvaged: {one_line(str(err))}"
+        ) from err
 
 
-def _read_stream(h5: h5py.File, path: Path, name: str, dtype: np.dtype[Any]) -> NDArray[np.void]:
-    if name not in h5 or not isinstance(h5[name], h5py.Dataset):
+def _read_stream(
+    h5: h5py.File, path: Path, name: str, dtype: np.dtype[Any], file_size: int, repairs: list[str]
+) -> NDArray[np.void]:
+    where = str(path)
+    link = h5.get(name, getlink=True)
+    if link is None:
         raise MissingChannelError(f"{path}: no dataset /{name}")
+    if not isinstance(link, h5py.HardLink):  # a soft or external link: not ours to follow
+        raise CorruptRecordingError(f"{path}: /{name} is a {type(link).__name__}, not a dataset")
     ds = h5[name]
-    names = ds.dtype.names or ()
-    missing = [f for f in dtype.names or () if f not in names]
-    if missing:
-        raise MissingChannelError(f"{path}: /{name} has no field(s) {', '.join(missing)}")
-    if ds.ndim != 1:
-        raise CorruptRecordingError(f"{path}: /{name} has shape {ds.shape}, expected 1-D")
+    if not isinstance(ds, h5py.Dataset):
+        raise MissingChannelError(f"{path}: no dataset /{name}")
+    check_dataset(ds, where, dtype, file_size)
+    try:
+        return _read_rows(ds, dtype, repairs)
+    except OSError as err:  # a chunk that fails its filter (gzip) or checksum
+        raise CorruptRecordingError(
+            f"{path}: dataset /{name} cannot be read: {one_line(str(err))}"
+        ) from err
+
+
+def _read_rows(ds: h5py.Dataset, dtype: np.dtype[Any], repairs: list[str]) -> NDArray[np.void]:
     if dtype.hasobject:
         raw = ds.fields(list(dtype.names or ()))[...]
         out = np.empty(len(raw), dtype=dtype)
         for field in dtype.names or ():
             column = raw[field]
             if dtype[field] == np.dtype(object):
-                column = [v.decode() if isinstance(v, bytes) else v for v in column]
+                column = [_text(v, i, f"{ds.name}.{field}", repairs) for i, v in enumerate(column)]
             out[field] = column
         return out
     if ds.dtype == dtype:
@@ -246,28 +269,55 @@ def _read_stream(h5: h5py.File, path: Path, name: str, dtype: np.dtype[Any]) -> 
     return np.asarray(ds.fields(list(dtype.names or ()))[...]).astype(dtype)
 
 
+def _text(value: Any, row: int, where: str, repairs: list[str]) -> Any:
+    """A string field's value; bytes that are not UTF-8 are kept, marked, and said so."""
+    if not isinstance(value, bytes):
+        return value
+    try:
+        return value.decode()
+    except UnicodeDecodeError:
+        repairs.append(f"{where} row {row} is not UTF-8: decoded with replacement characters")
+        return value.decode(errors="replace")
+
+
+#: What h5py raises for a damaged file: a failed checksum opening an object (KeyError),
+#: unreadable metadata or data (OSError, RuntimeError), a type it cannot convert.
+_H5_ERRORS = (KeyError, OSError, RuntimeError, TypeError, ValueError)
+
+
 def read_hdf5(path: Path, *, salvage: bool = False) -> Recording:
     """Read an HDF5 recording (see ``open_recording``)."""
+    check_global_heaps(path)
     h5, repairs = _open(path, salvage)
-    with h5:
-        version = h5.attrs.get("schema_version")
-        if version is None or "metadata_json" not in h5.attrs:
-            raise MissingChannelError(f"{path}: no labstand metadata (schema_version attribute)")
-        if int(version) > SCHEMA_VERSION:
-            raise SchemaVersionError(
-                f"{path}: schema version {int(version)} is newer than this labstand reads "
-                f"({SCHEMA_VERSION}); update labstand"
-            )
-        metadata = RecordingMetadata.from_json(h5.attrs["metadata_json"], str(path))
-        streams = {
-            name: _read_stream(h5, path, name, dtype)
-            for name, dtype in (
-                ("gauges", GAUGES_DTYPE),
-                ("command", COMMAND_DTYPE),
-                ("drive", DRIVE_DTYPE),
-                ("events", EVENTS_DTYPE),
-            )
-        }
+    try:
+        with h5:
+            return _read_open(h5, path, repairs)
+    except RecordingError:
+        raise
+    except _H5_ERRORS as err:
+        message = one_line(str(err).strip("'\"")) or type(err).__name__
+        raise CorruptRecordingError(f"{path}: damaged HDF5 file: {message}") from err
+
+
+def _read_open(h5: h5py.File, path: Path, repairs: list[str]) -> Recording:
+    where = str(path)
+    version = int_attr(h5.attrs, "schema_version", where)
+    if version > SCHEMA_VERSION:
+        raise SchemaVersionError(
+            f"{path}: schema version {version} is newer than this labstand reads "
+            f"({SCHEMA_VERSION}); update labstand"
+        )
+    metadata = RecordingMetadata.from_json(text_attr(h5.attrs, "metadata_json", where), where)
+    size = path.stat().st_size
+    streams = {
+        name: _read_stream(h5, path, name, dtype, size, repairs)
+        for name, dtype in (
+            ("gauges", GAUGES_DTYPE),
+            ("command", COMMAND_DTYPE),
+            ("drive", DRIVE_DTYPE),
+            ("events", EVENTS_DTYPE),
+        )
+    }
     return Recording(
         path=path,
         metadata=metadata,

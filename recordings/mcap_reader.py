@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 import zstandard
 from mcap.data_stream import ReadDataStream
+from mcap.exceptions import EndOfFile, McapError
 from mcap.records import Channel, Chunk, Metadata, Schema
 from numpy.typing import NDArray
 
@@ -25,6 +26,7 @@ from recordings.errors import (
     CorruptRecordingError,
     MissingChannelError,
     TruncatedRecordingError,
+    one_line,
 )
 from recordings.mcap_writer import (
     COMMAND_CODEC,
@@ -48,6 +50,10 @@ _RECORD = struct.Struct("<BQ")
 _MESSAGE_HEAD = struct.Struct("<HIQQ")
 _CHANNEL_ID = struct.Struct("<H")
 REQUIRED_TOPICS = ("/gauges", "/command", "/drive", "/events")
+#: A chunk may claim at most this much uncompressed data per compressed byte (zstd and lz4
+#: reach a few hundred on real data); a bit flip in the size field then cannot allocate GBs.
+MAX_CHUNK_RATIO = 1024
+MAX_CHUNK_BYTES = 2**30
 
 
 class _Walk:
@@ -105,6 +111,8 @@ class _Walk:
         while pos < end:  # the hot loop: one pass per message, kept lean on purpose
             opcode, length = record_head(view, pos)
             stop = pos + _RECORD.size + length
+            if stop > end:
+                break  # a damaged length: "ends mid-record" below
             if opcode == _MESSAGE:
                 (channel_id,) = channel_of(view, pos + _RECORD.size)
                 if channel_id not in skip:
@@ -117,6 +125,12 @@ class _Walk:
 
     def _decompress(self, chunk: Chunk) -> bytes:
         where = f"{self.where}: chunk {self.chunks + 1}"
+        limit = min(MAX_CHUNK_RATIO * len(chunk.data) + 2**16, MAX_CHUNK_BYTES)
+        if chunk.uncompressed_size > limit:
+            raise CorruptRecordingError(
+                f"{where}: claims {chunk.uncompressed_size} bytes uncompressed from "
+                f"{len(chunk.data)} compressed (at most {limit})"
+            )
         try:
             if chunk.compression == "zstd":
                 data = self._zstd.decompress(chunk.data, max_output_size=chunk.uncompressed_size)
@@ -128,8 +142,10 @@ class _Walk:
                 data = chunk.data
             else:
                 raise CorruptRecordingError(f"{where}: unknown compression {chunk.compression!r}")
-        except zstandard.ZstdError as err:
-            raise CorruptRecordingError(f"{where}: does not decompress: {err}") from err
+        except (zstandard.ZstdError, RuntimeError) as err:  # lz4 raises RuntimeError
+            raise CorruptRecordingError(
+                f"{where}: does not decompress: {one_line(str(err))}"
+            ) from err
         if len(data) != chunk.uncompressed_size:
             raise CorruptRecordingError(
                 f"{where}: {len(data)} bytes, the header says {chunk.uncompressed_size}"
@@ -167,11 +183,18 @@ def _walk_file(path: Path, salvage: bool) -> _Walk:
             continue
         try:
             walk.record(opcode, body)
-        except (struct.error, ValueError, UnicodeDecodeError) as err:
+        # OverflowError: a length field near 2**64 handed to BytesIO.read or a slice
+        except (struct.error, ValueError, UnicodeDecodeError, McapError, OverflowError) as err:
             if isinstance(err, CorruptRecordingError):
                 raise
+            if isinstance(err, EndOfFile):
+                detail = "it ends before its fields do"
+            elif isinstance(err, OverflowError):
+                detail = "a length field in it is larger than any file"
+            else:
+                detail = one_line(str(err))
             raise CorruptRecordingError(
-                f"{where}: record {opcode:#04x} at byte {pos} does not decode: {err}"
+                f"{where}: record {opcode:#04x} at byte {pos} does not decode: {detail}"
             ) from err
         pos += _RECORD.size + length
         if opcode == _DATA_END:

@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from recordings.errors import CorruptRecordingError, InvalidDataError, SchemaVersionError
+from recordings.errors import CorruptRecordingError, InvalidDataError, SchemaVersionError, shown
 
 __all__ = [
     "COMMAND_DTYPE",
@@ -218,11 +218,18 @@ class RecordingMetadata:
         """Check and build; ``where`` (the file) prefixes every complaint."""
         version_ = data.get("schema_version")
         if not isinstance(version_, int) or isinstance(version_, bool) or version_ < 1:
-            raise CorruptRecordingError(f"{where}: metadata has no valid schema_version")
+            raise CorruptRecordingError(
+                f"{where}: metadata has no valid schema_version: {shown(version_)}"
+            )
         if version_ > SCHEMA_VERSION:
             raise SchemaVersionError(
                 f"{where}: schema version {version_} is newer than this labstand reads "
                 f"({SCHEMA_VERSION}); update labstand"
+            )
+        rate = data.get("sample_rate_hz")
+        if isinstance(rate, bool) or not isinstance(rate, int | float) or not 0 < rate < 1e12:
+            raise CorruptRecordingError(
+                f"{where}: metadata sample_rate_hz must be a number of Hz > 0, got {shown(rate)}"
             )
         try:
             effects = tuple(
@@ -243,19 +250,21 @@ class RecordingMetadata:
                 schema_version=version_,
             )
             _ = meta.start_time_ns
-        except (KeyError, TypeError, ValueError, AttributeError) as err:
+        except (KeyError, TypeError, ValueError, AttributeError, OverflowError) as err:
             raise CorruptRecordingError(f"{where}: metadata is unusable: {err!r}") from err
-        if not (np.isfinite(meta.sample_rate_hz) and meta.sample_rate_hz > 0):
-            raise CorruptRecordingError(f"{where}: metadata sample_rate_hz must be > 0 Hz")
         return meta
 
     @classmethod
     def from_json(cls, text: str | bytes, where: str) -> RecordingMetadata:
         """Parse ``to_json`` output."""
+        if not isinstance(text, str | bytes):
+            raise CorruptRecordingError(f"{where}: metadata is not text but {shown(text)}")
         try:
             data = json.loads(text)
         except (ValueError, UnicodeDecodeError) as err:
             raise CorruptRecordingError(f"{where}: metadata is not valid JSON: {err}") from err
+        except RecursionError:  # json recurses once per nested array or object
+            raise CorruptRecordingError(f"{where}: metadata JSON is nested too deeply") from None
         if not isinstance(data, dict):
             raise CorruptRecordingError(f"{where}: metadata is not a JSON object")
         return cls.from_dict(data, where)

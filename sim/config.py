@@ -11,6 +11,7 @@ from __future__ import annotations
 import copy
 import itertools
 import math
+import re
 import tomllib
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
@@ -34,6 +35,9 @@ __all__ = [
 #: The drive's mechanical stroke [paper]; a configured limit beyond it is refused.
 STROKE_MAX_MM = 90.0
 DEFAULT_SOURCE = "<default stand>"
+#: Arrays, inline tables and dotted keys nested deeper than this are refused before parsing
+#: (tomllib recurses once per level; the stand file's deepest key is 3 levels down).
+MAX_NESTING = 16
 
 
 class ConfigError(ValueError):
@@ -76,10 +80,20 @@ class DeviceConfig:
 Check = Callable[[Any], str | None]  # returns a complaint, or None when the value is fine
 
 
+def _show(value: Any) -> str:
+    """``repr`` of a value, cut short: a message stays one readable line."""
+    if isinstance(value, int) and value.bit_length() > 200:  # repr fails beyond 4300 digits
+        return f"an integer of {value.bit_length()} bits"
+    text = repr(value)
+    return text if len(text) <= 60 else f"{text[:57]}..."
+
+
 def _number(lo: float | None = None, hi: float | None = None, strict: bool = True) -> Check:
     def check(value: Any) -> str | None:
         if isinstance(value, bool) or not isinstance(value, int | float):
-            return f"must be a number, got {type(value).__name__} {value!r}"
+            return f"must be a number, got {type(value).__name__} {_show(value)}"
+        if isinstance(value, int) and value.bit_length() > 1000:  # beyond float64: 2**1024
+            return f"must be a number in range, got an integer of {value.bit_length()} bits"
         if not math.isfinite(value):
             return f"must be finite, got {value}"
         if lo is not None and (value <= lo if strict else value < lo):
@@ -92,12 +106,12 @@ def _number(lo: float | None = None, hi: float | None = None, strict: bool = Tru
 
 
 def _text(value: Any) -> str | None:
-    return None if isinstance(value, str) else f"must be a string, got {value!r}"
+    return None if isinstance(value, str) else f"must be a string, got {_show(value)}"
 
 
 def _number_list(value: Any) -> str | None:
     if not isinstance(value, list) or len(value) < 2:
-        return f"must be a list of at least 2 numbers, got {value!r}"
+        return f"must be a list of at least 2 numbers, got {_show(value)}"
     for item in value:
         if (msg := _number(0.0, strict=False)(item)) is not None:
             return f"every entry {msg}"
@@ -106,19 +120,19 @@ def _number_list(value: Any) -> str | None:
 
 def _drive_url(value: Any) -> str | None:
     if not isinstance(value, str) or not value.startswith(("tcp://", "rtu://")):
-        return f"must be a tcp://HOST:PORT or rtu://PATH URL, got {value!r}"
+        return f"must be a tcp://HOST:PORT or rtu://PATH URL, got {_show(value)}"
     return None
 
 
 def _port(value: Any) -> str | None:
     if not isinstance(value, str) or not value.strip():
-        return f"must be a serial port path, got {value!r}"
+        return f"must be a serial port path, got {_show(value)}"
     return None
 
 
 def _baudrate(value: Any) -> str | None:
     if isinstance(value, bool) or not isinstance(value, int) or value <= 0:
-        return f"must be a positive whole number of baud, got {value!r}"
+        return f"must be a positive whole number of baud, got {_show(value)}"
     return None
 
 
@@ -221,7 +235,7 @@ def _complain(source: str, table: str, key: str, msg: str) -> ConfigError:
 
 def _check_table(source: str, name: str, table: Any, checks: dict[str, Check]) -> None:
     if not isinstance(table, dict):
-        raise ConfigError(f"{source}: [{name}] must be a table, got {table!r}")
+        raise ConfigError(f"{source}: [{name}] must be a table, got {_show(table)}")
     for key, value in table.items():
         if key not in checks:
             expected = ", ".join(sorted(checks))
@@ -276,7 +290,8 @@ def config_from_dict(data: Mapping[str, Any], source: str = DEFAULT_SOURCE) -> S
             _check_table(source, f"{group}.{name}", table, checks)
         tables[group] = merged[group]
     weights = merged["weights_kg"]
-    _check_table(source, "weights_kg", weights, {name: POSITIVE for name in weights})
+    named = {name: POSITIVE for name in weights} if isinstance(weights, dict) else {}
+    _check_table(source, "weights_kg", weights, named)
     default_weight = merged["weight"]["default"]
     if default_weight not in weights:
         msg = f"names no weight in [weights_kg] ({', '.join(sorted(weights))}): {default_weight!r}"
@@ -349,8 +364,67 @@ def load_config(path: str | Path | None) -> StandConfig:
         raise ConfigError(f"{p}: no such stand file") from None
     except (OSError, UnicodeDecodeError) as err:
         raise ConfigError(f"{p}: cannot read stand file: {err}") from None
+    if (where := _too_deep_text(text)) is not None:
+        raise ConfigError(f"{p}: {where}: arrays or tables nested deeper than {MAX_NESTING} levels")
     try:
         data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as err:
+    except ValueError as err:  # TOMLDecodeError, or int() of more than 4300 digits
         raise ConfigError(f"{p}: not valid TOML: {err}") from None
+    if (key := _too_deep_data(data)) is not None:
+        raise ConfigError(f"{p}: key {key}: tables nested deeper than {MAX_NESTING} levels")
     return config_from_dict(data, str(p))
+
+
+_TOKENS = re.compile(r"[\[\]{}\"'#\n]")
+
+
+def _too_deep_text(text: str) -> str | None:
+    """``line N`` where brackets outside strings and comments nest too deeply, or None.
+
+    tomllib recurses once per nested array or inline table, so a file of thousands of
+    ``[`` would end in a RecursionError; this scan is iterative.
+    """
+    depth, line, pos = 0, 1, 0
+    while (m := _TOKENS.search(text, pos)) is not None:
+        c, pos = m.group(), m.end()
+        if c == "\n":
+            line += 1
+        elif c == "#":
+            end = text.find("\n", pos)
+            pos = len(text) if end < 0 else end
+        elif c in "\"'":
+            quote = c * 3 if text.startswith(c * 2, pos) else c
+            end = _string_end(text, m.start() + len(quote), quote)
+            line += text.count("\n", pos, end)
+            pos = end
+        elif c in "[{":
+            depth += 1
+            if depth > MAX_NESTING:
+                return f"line {line}"
+        else:
+            depth = max(depth - 1, 0)
+    return None
+
+
+def _string_end(text: str, pos: int, quote: str) -> int:
+    """The index after the string's closing quote (or the text's end: tomllib complains)."""
+    while (end := text.find(quote, pos)) >= 0:
+        backslashes = len(text[pos:end]) - len(text[pos:end].rstrip("\\"))
+        if quote[0] == "'" or backslashes % 2 == 0:
+            return end + len(quote)
+        pos = end + 1
+    return len(text)
+
+
+def _too_deep_data(data: dict[str, Any]) -> str | None:
+    """The dotted key where parsed tables nest too deeply (``a.b.c = 1`` has no brackets)."""
+    stack: list[tuple[str, Any, int]] = [("", data, 0)]
+    while stack:
+        key, value, depth = stack.pop()
+        if depth > MAX_NESTING:
+            return key
+        if isinstance(value, dict):
+            stack.extend((f"{key}.{k}" if key else k, v, depth + 1) for k, v in value.items())
+        elif isinstance(value, list):
+            stack.extend((key, v, depth + 1) for v in value)
+    return None
