@@ -4,8 +4,10 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from sim.config import StandConfig, load_config
+if TYPE_CHECKING:
+    from sim.config import StandConfig
 
 
 def add_stand_options(parser: argparse.ArgumentParser, params: bool = False) -> None:
@@ -24,4 +26,6 @@ def add_stand_options(parser: argparse.ArgumentParser, params: bool = False) -> 
 
 def load_stand(args: argparse.Namespace) -> StandConfig:
     """The stand configuration the user chose, validated."""
+    from sim.config import load_config  # scipy: only when a command runs
+
     return load_config(getattr(args, "stand", None))

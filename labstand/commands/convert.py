@@ -6,15 +6,12 @@ import argparse
 from pathlib import Path
 
 from labstand.errors import CommandError, ExitCode
-from recordings import open_recording
-from recordings.convert import write_recording
 
 
 def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Add ``labstand convert``."""
     parser = sub.add_parser(
         "convert",
-        help="convert a recording between MCAP and HDF5",
         description="Convert recording A into B; the suffixes pick the formats (.mcap, .h5, "
         ".hdf5). Every stream and the metadata are copied as they are.",
     )
@@ -25,6 +22,9 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Read A, write B."""
+    from recordings import open_recording
+    from recordings.convert import write_recording
+
     if args.source.resolve() == args.target.resolve():
         raise CommandError(f"{args.target}: would overwrite the source", ExitCode.USAGE)
     recording = open_recording(args.source)

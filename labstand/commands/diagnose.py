@@ -7,22 +7,20 @@ import dataclasses
 import json
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-import numpy as np
-import pandas as pd
-
-from labstand.diagnosis_report import write_report
 from labstand.errors import CommandError, ExitCode
-from recordings import RecordingError, open_recording
-from sim.config import ConfigError, config_from_dict, load_config
-from sim.identify import Diagnosis, DiagnosisInputError, Trace, diagnose, make_trace
+
+if TYPE_CHECKING:
+    import pandas as pd
+
+    from sim.identify import Diagnosis, Trace
 
 
 def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Add ``labstand diagnose``."""
     parser = sub.add_parser(
         "diagnose",
-        help="find which unmodelled effect explains the gap between model and recordings",
         description="Fit the baseline (stiffness, damping, friction scale) to one or more "
         "recordings of one stand, say where the remaining gap lies, which of the nine "
         "candidate effects explains it (judged on held-out cycles), and how far it shrinks.",
@@ -48,6 +46,8 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
 def _mass_of(path: Path, stored: object, override: float | None, fallback: float) -> float:
     if override is not None:
         return override
+    from sim.config import ConfigError, config_from_dict
+
     try:
         return config_from_dict(stored, str(path)).default_mass_kg  # type: ignore[arg-type]
     except (ConfigError, TypeError):
@@ -56,6 +56,10 @@ def _mass_of(path: Path, stored: object, override: float | None, fallback: float
 
 def trace_of(name: str, frame: pd.DataFrame, mass_kg: float) -> Trace:
     """A recording's frame (t_s index, x_mm, u_mm, F_N) as a diagnosis trace (SI units)."""
+    import numpy as np
+
+    from sim.identify import DiagnosisInputError, make_trace
+
     for column in ("x_mm", "u_mm", "F_N"):
         if column not in frame.columns:
             raise DiagnosisInputError(f"{name}: the recording has no {column} channel")
@@ -71,6 +75,11 @@ def trace_of(name: str, frame: pd.DataFrame, mass_kg: float) -> Trace:
 
 def run(args: argparse.Namespace) -> int:
     """Read, diagnose, report."""
+    from labstand.diagnosis_report import write_report
+    from recordings import RecordingError, open_recording
+    from sim.config import load_config
+    from sim.identify import DiagnosisInputError, diagnose
+
     config = load_config(args.stand)
     nominal = config.stand_params(args.params)
     if args.mass_kg is not None and not args.mass_kg > 0:

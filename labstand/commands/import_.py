@@ -3,16 +3,14 @@
 from __future__ import annotations
 
 import argparse
+import importlib
 from pathlib import Path
 
 from labstand.commands.common import add_stand_options, load_stand
 from labstand.errors import CommandError, ExitCode
-from recordings.convert import summary, with_changes, write_recording
-from recordings.csvio import read_csv
-from recordings.foreign import parse_mapping
-from recordings.tdmsio import read_tdms
 
-_READERS = {".csv": read_csv, ".tdms": read_tdms}
+#: suffix -> the module and function that read it (imported only when the command runs)
+_READERS = {".csv": ("recordings.csvio", "read_csv"), ".tdms": ("recordings.tdmsio", "read_tdms")}
 
 MAP_HELP = """\
 which column holds which quantity: FIELD=COLUMN or FIELD=COLUMN[UNIT], repeatable.
@@ -27,7 +25,6 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Add ``labstand import``."""
     parser = sub.add_parser(
         "import",
-        help="import a CSV or TDMS run as a recording",
         description="Import a run exported from another tool (CSV) or recorded by the old "
         "LabVIEW stand (TDMS) into a recording (-o OUT.mcap or OUT.h5). Units are "
         "converted to the schema's (mm, N); a truncated TDMS file is trimmed to its "
@@ -48,11 +45,15 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Read, map, check, write."""
-    reader = _READERS.get(args.file.suffix.lower())
-    if reader is None:
+    from recordings.convert import summary, with_changes, write_recording
+    from recordings.foreign import parse_mapping
+
+    where = _READERS.get(args.file.suffix.lower())
+    if where is None:
         raise CommandError(
             f"{args.file}: cannot import {args.file.suffix!r}; use .csv or .tdms", ExitCode.USAGE
         )
+    reader = getattr(importlib.import_module(where[0]), where[1])
     mapping = parse_mapping(args.map)
     config = load_stand(args)
     recording = reader(args.file, mapping=mapping, stand_config=config.to_dict())

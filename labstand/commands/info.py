@@ -7,15 +7,11 @@ import json
 from pathlib import Path
 from typing import Any
 
-from recordings import open_recording
-from recordings.convert import summary
-
 
 def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Add ``labstand info``."""
     parser = sub.add_parser(
         "info",
-        help="duration, channels, rates, lost samples and metadata of a recording",
         description="Summarise a recording (.mcap, .h5, or a .csv/.tdms run). JSON keys: "
         "duration_s, lost_samples, channels (name -> {unit, rate_hz, samples}), metadata, ...",
     )
@@ -26,6 +22,9 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Read and summarise."""
+    from recordings import open_recording
+    from recordings.convert import summary
+
     info = summary(open_recording(args.recording))
     if args.json:
         print(json.dumps(info, indent=2))

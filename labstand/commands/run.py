@@ -22,35 +22,30 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from types import FrameType
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from drivers.signals import SignalSpec, plan_motion
 from labstand.commands.common import add_stand_options, load_stand
 from labstand.commands.simulate import add_signal_options, signal_from_args
-from labstand.display import make_display
 from labstand.errors import CommandError, ExitCode
-from labstand.session import (
-    Outcome,
-    Preflight,
-    PreflightError,
-    RunResult,
-    Session,
-    StopRequest,
-)
-from labstand.session_devices import BACKENDS, Devices, default_backend, open_devices
-from labstand.session_record import RecordingPipe
-from labstand.session_safety import EStopError, SafetyLimits
-from recordings.base import FORMATS, open_writer
-from recordings.schema import Effect, RecordingMetadata, make_metadata
-from sim.config import StandConfig, config_from_dict
-from sim.effects import EffectSpec, parse_effects
+from labstand.session_safety import SafetyLimits
+
+if TYPE_CHECKING:  # the rest is imported where it runs: `labstand run --help` stays quick
+    from drivers.signals import SignalSpec
+    from labstand.session import Preflight, RunResult, Session, StopRequest
+    from labstand.session_devices import Devices
+    from recordings.schema import RecordingMetadata
+    from sim.config import StandConfig
+    from sim.effects import EffectSpec
+
+#: labstand.session_devices.BACKENDS (which imports pymodbus), as a literal for the parser;
+#: tests/core/test_cli_startup.py checks that the two agree.
+BACKENDS = ("stand", "sim")
 
 
 def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Add ``labstand run``."""
     parser = sub.add_parser(
         "run",
-        help="run a test on the stand (or the simulated stand) and record it",
         description="Run a drive signal on the stand and record gauges (2 kHz), drive "
         "states and events to -o OUT (.mcap or .h5). --backend sim starts the simulated "
         "stand (same wire protocols) and is the default when the stand file has no "
@@ -99,6 +94,8 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
 
 def config_with_mass(config: StandConfig, mass_kg: float) -> dict[str, Any]:
     """The stand configuration whose default weight is the mass on the stand."""
+    from sim.config import config_from_dict
+
     raw = config.to_dict()
     weights = raw["weights_kg"]
     name = next((n for n, m in weights.items() if m == mass_kg), None)
@@ -121,6 +118,8 @@ def _title(args: argparse.Namespace, spec: SignalSpec, mass_kg: float) -> str:
 
 
 def _effects(args: argparse.Namespace, backend: str) -> list[EffectSpec]:
+    from sim.effects import parse_effects
+
     effects = parse_effects(args.effect)
     if effects and backend != "sim":
         raise CommandError("--effect needs --backend sim", ExitCode.USAGE)
@@ -142,6 +141,10 @@ class _Plan:
 
 def _check(args: argparse.Namespace) -> _Plan:
     """Every check that needs no device: usage (2) and refusals (3)."""
+    from drivers.signals import plan_motion
+    from labstand.session_devices import default_backend
+    from recordings.base import formats
+
     config = load_stand(args)
     spec, mass = signal_from_args(args, config)
     backend = args.backend or default_backend(config)
@@ -160,8 +163,9 @@ def _check(args: argparse.Namespace) -> _Plan:
     )
     plan_motion(spec, config.drive)  # LimitError: refused before anything is touched
     suffix = args.output.suffix.lower()
-    if suffix not in FORMATS or FORMATS[suffix][1] is None:
-        writable = sorted(s for s, f in FORMATS.items() if f[1] is not None)
+    known = formats()
+    if suffix not in known or known[suffix][1] is None:
+        writable = sorted(s for s, f in known.items() if f[1] is not None)
         raise CommandError(
             f"{args.output}: cannot record {suffix or 'without a suffix'!r}; use one of "
             f"{', '.join(writable)}",
@@ -180,6 +184,10 @@ def _check(args: argparse.Namespace) -> _Plan:
 
 def run(args: argparse.Namespace) -> int:
     """Check, confirm, run, report."""
+    from labstand.display import make_display
+    from labstand.session import Session
+    from labstand.session_devices import open_devices
+
     if not args.verbose:  # its time-outs are reported by the drive driver, once
         logging.getLogger("pymodbus").setLevel(logging.CRITICAL)
     plan = _check(args)
@@ -209,6 +217,10 @@ def _session(
     session: Session, devices: Devices, plan: _Plan, args: argparse.Namespace, title: str
 ) -> RunResult:
     """Pre-flight, summary, confirmation, prepare, then the recorded run."""
+    from labstand.session import PreflightError, StopRequest
+    from labstand.session_safety import EStopError
+    from recordings.schema import Effect, make_metadata
+
     try:
         pre = session.preflight(plan.spec, args.reset_trip)
     except PreflightError as err:
@@ -247,6 +259,9 @@ def _record(
     title: str,
 ) -> RunResult:
     """The run itself, recording into the output; the file is closed on every path."""
+    from labstand.session_record import RecordingPipe
+    from recordings.base import open_writer
+
     pipe = RecordingPipe(open_writer(args.output, metadata))
     try:
         if args.note:
@@ -321,6 +336,8 @@ def _stop_signals(stop: StopRequest) -> Iterator[None]:
 
 
 def _report(result: RunResult, output: Path, sim: dict[str, Any]) -> int:
+    from labstand.session import Outcome
+
     stats = result.stats
     where = (
         f"recording {output} closed ({result.elapsed_s:.2f} s, {result.samples} samples, "

@@ -7,16 +7,11 @@ import json
 from pathlib import Path
 from typing import Any
 
-from labstand.recording_stand import params_for
-from recordings import open_recording
-from recordings.replay import replay
-
 
 def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Add ``labstand table1``."""
     parser = sub.add_parser(
         "table1",
-        help="Table 1 of the paper: R per channel for two parameter sets",
         description="For each recording, R of the weight displacement and of the dynamic "
         "force for two parameter sets side by side (the paper's Table 1), plus NRMSE.",
     )
@@ -30,6 +25,10 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Replay every recording with both sets and tabulate."""
+    from labstand.recording_stand import params_for
+    from recordings import open_recording
+    from recordings.replay import replay
+
     rows: list[dict[str, Any]] = []
     for path in args.recordings:
         recording = open_recording(path)
