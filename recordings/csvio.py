@@ -6,7 +6,6 @@ column mapping (see ``recordings.foreign``).
 
 from __future__ import annotations
 
-import os
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -15,6 +14,7 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
+from recordings.atomic import written_whole
 from recordings.base import register_format
 from recordings.errors import ImportMappingError
 from recordings.foreign import FIELDS, ColumnMap, build_recording, resolve, to_unit
@@ -35,9 +35,8 @@ def write_csv(
 ) -> None:
     """Write the four columns; written to a temporary name first, so a crash leaves no stub."""
     table = np.column_stack([t_s, x_mm, u_mm, force_n])
-    tmp = path.with_name(path.name + ".part")
-    np.savetxt(tmp, table, delimiter=",", header=HEADER, comments="", fmt="%.9g")
-    os.replace(tmp, path)
+    with written_whole(path) as tmp:
+        np.savetxt(tmp, table, delimiter=",", header=HEADER, comments="", fmt="%.9g")
 
 
 def _numeric(frame: pd.DataFrame, column: str, where: str) -> NDArray[np.float64]:

@@ -167,7 +167,9 @@ class Recording:
         }
 
 
-def open_recording(path: str | Path, *, salvage: bool = False) -> Recording:
+def open_recording(
+    path: str | Path, *, salvage: bool = False, log_repairs: bool = True
+) -> Recording:
     """Read a recording (.mcap, .h5/.hdf5) or a foreign run (.csv, .tdms), checked.
 
     Parameters
@@ -178,6 +180,9 @@ def open_recording(path: str | Path, *, salvage: bool = False) -> Recording:
         Read what can be read from a damaged file (a truncated MCAP, an HDF5 file whose
         writer was killed) and list what was done in ``Recording.repairs``, instead of
         raising TruncatedRecordingError.
+    log_repairs
+        Log each repair as a warning (the default); callers that print
+        ``Recording.repairs`` themselves pass False, so the user reads each once.
 
     Raises
     ------
@@ -187,6 +192,6 @@ def open_recording(path: str | Path, *, salvage: bool = False) -> Recording:
     p = Path(path)
     recording: Recording = reader_for(p)(p, salvage=salvage)
     recording.check()
-    for line in recording.repairs:
+    for line in recording.repairs if log_repairs else ():
         log.warning("%s: %s", p, line)
     return recording

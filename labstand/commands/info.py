@@ -25,7 +25,7 @@ def run(args: argparse.Namespace) -> int:
     from recordings import open_recording
     from recordings.convert import summary
 
-    info = summary(open_recording(args.recording))
+    info = summary(open_recording(args.recording, log_repairs=False))
     if args.json:
         print(json.dumps(info, indent=2))
     else:

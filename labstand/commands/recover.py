@@ -29,7 +29,7 @@ def run(args: argparse.Namespace) -> int:
 
     if args.broken.resolve() == args.output.resolve():
         raise CommandError(f"{args.output}: would overwrite the damaged file", ExitCode.USAGE)
-    recording = open_recording(args.broken, salvage=True)
+    recording = open_recording(args.broken, salvage=True, log_repairs=False)
     write_recording(recording, args.output)
     print(
         f"Recovered {len(recording.gauges)} samples ({recording.duration_s:.3f} s, "
