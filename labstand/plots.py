@@ -9,6 +9,12 @@ from recordings.replay import ReplayResult
 from sim.results import SimResult
 
 _UNITS = {"u": "weight u [mm]", "F": "fibre force F [N]", "F_dyn": "dynamic force F − T₀ [N]"}
+_RESIDUAL_UNITS = {"u": "Δu [mm]", "F": "ΔF [N]", "F_dyn": "Δ(F − T₀) [N]"}
+
+
+def r_text(r: float) -> str:
+    """R as the paper prints it: six decimals (0.999961); rounding to 4 would hide the gap."""
+    return f"{r:.6f}"
 
 
 def pyplot() -> ModuleType:
@@ -80,11 +86,16 @@ def plot_replay(
         ax.plot(t, rec, color="k", lw=0.9, label=first_label)
         ax.plot(t, sim, color="tab:red", lw=0.9, ls="--", label=second_label)
         ax.set_ylabel(_UNITS[name])
-        ax.set_title(f"{name}: R = {m.R:.4f}, ψ = {m.psi:.3g}, NRMSE = {m.nrmse:.3f}", fontsize=9)
-        ax.legend(loc="upper right", fontsize=8)
-        res_ax.plot(t, sim - rec, color="tab:purple", lw=0.7)
+        ax.set_title(
+            f"{name}: R = {r_text(m.R)}, ψ = {m.psi:.3g}, NRMSE = {m.nrmse:.4f}", fontsize=10
+        )
+        ax.legend(loc="upper right", fontsize=9, framealpha=0.9)
+        res_ax.plot(
+            t, sim - rec, color="tab:purple", lw=0.7, label=f"{second_label} − {first_label}"
+        )
         res_ax.axhline(0, color="k", lw=0.4)
-        res_ax.set_ylabel("residual")
+        res_ax.set_ylabel(_RESIDUAL_UNITS[name])
+        res_ax.legend(loc="best", fontsize=9, framealpha=0.9)
     for ax in axes:
         ax.grid(alpha=0.3)
     axes[-1].set_xlabel("time [s]")
