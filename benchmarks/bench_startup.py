@@ -1,14 +1,16 @@
-"""Start-up of the labstand command: wall time and peak memory, side by side with numpy.
+"""Start-up of the labstand command: time and peak memory, side by side with numpy.
 
     .venv/bin/python benchmarks/bench_startup.py [--runs 11] [--before SRC_TREE]
 
 Each command runs in a fresh subprocess, ``--runs`` times, the commands interleaved
 round-robin so that the load of this shared machine falls on all of them alike; the
-table gives the median wall time and the peak RSS (``ru_maxrss`` of that child, from
-``os.wait4``). The reference is ``python -c 'import numpy'``, the least any numerical
-command pays. ``--before`` runs the same labstand commands also from another source tree
-(e.g. a checkout of the commit before lazy imports), in the same rounds. ``info`` reads a
-small recording the script makes first (situation 11, 4 s at 2 kHz, MCAP).
+table gives the median wall time, the median CPU time (user + sys: what the command
+costs, which the other sessions' load inflates far less than wall time) and the peak
+RSS (``ru_maxrss`` of that child, from ``os.wait4``). The reference is
+``python -c 'import numpy'``, the least any numerical command pays. ``--before`` runs
+the same labstand commands also from another source tree (e.g. ``git archive`` of the
+commit before lazy imports, unpacked), in the same rounds. ``info`` reads a small
+recording the script makes first (situation 11, 4 s at 2 kHz, MCAP).
 """
 
 from __future__ import annotations
@@ -25,8 +27,8 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent.parent
 
 
-def measure(argv: list[str], env: dict[str, str], cwd: Path) -> tuple[float, float]:
-    """Wall time (s) and peak RSS (MB) of one run of ``argv``; it must exit 0."""
+def measure(argv: list[str], env: dict[str, str], cwd: Path) -> tuple[float, float, float]:
+    """Wall time (s), CPU time (s) and peak RSS (MB) of one run of ``argv`` (exit 0)."""
     started = time.perf_counter()
     proc = subprocess.Popen(
         argv, env=env, cwd=cwd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE
@@ -39,7 +41,7 @@ def measure(argv: list[str], env: dict[str, str], cwd: Path) -> tuple[float, flo
         raise SystemExit(f"{' '.join(argv)}: exit {proc.returncode}: {err.strip()}")
     if proc.stderr:
         proc.stderr.close()
-    return wall, usage.ru_maxrss / 1024  # Linux: KiB
+    return wall, usage.ru_utime + usage.ru_stime, usage.ru_maxrss / 1024  # Linux: KiB
 
 
 def main() -> None:
@@ -77,19 +79,22 @@ def main() -> None:
         for _, argv, cenv in cases:  # warm the file cache and numba's on-disk cache
             measure(argv, cenv, folder)
         walls: dict[str, list[float]] = {name: [] for name, _, _ in cases}
+        cpus: dict[str, list[float]] = {name: [] for name in walls}
         rss: dict[str, float] = dict.fromkeys(walls, 0.0)
         load = os.getloadavg()[0]
         for _ in range(args.runs):
             for name, argv, cenv in cases:
-                wall, peak = measure(argv, cenv, folder)
+                wall, cpu, peak = measure(argv, cenv, folder)
                 walls[name].append(wall)
+                cpus[name].append(cpu)
                 rss[name] = max(rss[name], peak)
         load = (load + os.getloadavg()[0]) / 2
     print(f"median of {args.runs} runs, load average ≈ {load:.1f} ({os.cpu_count()} cores)\n")
-    print("| command | wall time (median) | peak RSS |")
-    print("|---|---|---|")
+    print("| command | wall time (median) | CPU time, user + sys (median) | peak RSS |")
+    print("|---|---|---|---|")
     for name, times in walls.items():
-        print(f"| `{name}` | {statistics.median(times):.3f} s | {rss[name]:.0f} MB |")
+        wall, cpu = statistics.median(times), statistics.median(cpus[name])
+        print(f"| `{name}` | {wall:.3f} s | {cpu:.3f} s | {rss[name]:.0f} MB |")
 
 
 if __name__ == "__main__":

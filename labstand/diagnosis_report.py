@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from labstand.plots import pyplot
+from labstand.plots import pyplot, r_text
 from sim.identify import Diagnosis, Trace
 from sim.identify.traces import PHASES
 
@@ -141,11 +141,11 @@ def _table(rows: Mapping[str, object]) -> str:
     return f"<table>{cells}</table>"
 
 
-def _fmt(value: object) -> str:
+def _fmt(value: object, key: object = None) -> str:
     if isinstance(value, float):
-        return f"{value:.4g}"
+        return r_text(value) if key == "R" else f"{value:.4g}"
     if isinstance(value, dict):
-        return ", ".join(f"{html.escape(str(k))} {_fmt(v)}" for k, v in value.items())
+        return ", ".join(f"{html.escape(str(k))} {_fmt(v, k)}" for k, v in value.items())
     return html.escape(str(value))
 
 
