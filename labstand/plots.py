@@ -4,9 +4,13 @@ from __future__ import annotations
 
 from pathlib import Path
 from types import ModuleType
+from typing import TYPE_CHECKING, cast
 
-from recordings.replay import ReplayResult
-from sim.results import SimResult
+if TYPE_CHECKING:  # matplotlib is imported when a plot is drawn, not with this module
+    from matplotlib.figure import Figure
+
+    from recordings.replay import ReplayResult
+    from sim.results import SimResult
 
 _UNITS = {"u": "weight u [mm]", "F": "fibre force F [N]", "F_dyn": "dynamic force F − T₀ [N]"}
 _RESIDUAL_UNITS = {"u": "Δu [mm]", "F": "ΔF [N]", "F_dyn": "Δ(F − T₀) [N]"}
@@ -29,6 +33,13 @@ def pyplot() -> ModuleType:
 
 def plot_run(path: Path, result: SimResult, title: str) -> None:
     """Drive position, weight displacement and fibre force over time, one panel each."""
+    fig = run_figure(result, title)
+    fig.savefig(path, dpi=110)
+    pyplot().close(fig)
+
+
+def run_figure(result: SimResult, title: str) -> Figure:
+    """The figure of ``plot_run``."""
     plt = pyplot()
 
     fig, axes = plt.subplots(3, 1, sharex=True, figsize=(10, 7), constrained_layout=True)
@@ -55,8 +66,7 @@ def plot_run(path: Path, result: SimResult, title: str) -> None:
     for ax in axes:
         ax.grid(alpha=0.3)
     fig.suptitle(title)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    return cast("Figure", fig)  # pyplot() is a plain module to mypy
 
 
 def plot_replay(
@@ -67,6 +77,15 @@ def plot_replay(
     first_label: str = "recorded",
 ) -> None:
     """Recorded vs simulated u and F − T₀ (like the paper's figures), with the residuals."""
+    fig = replay_figure(result, title, second_label, first_label)
+    fig.savefig(path, dpi=110)
+    pyplot().close(fig)
+
+
+def replay_figure(
+    result: ReplayResult, title: str, second_label: str = "simulated", first_label: str = "recorded"
+) -> Figure:
+    """The figure of ``plot_replay``."""
     plt = pyplot()
 
     channels = ("u", "F_dyn")
@@ -100,5 +119,4 @@ def plot_replay(
         ax.grid(alpha=0.3)
     axes[-1].set_xlabel("time [s]")
     fig.suptitle(title)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    return cast("Figure", fig)  # pyplot() is a plain module to mypy
