@@ -105,3 +105,31 @@ def test_diagnose_check_refuses_an_unknown_class_before_running(
     assert main(["diagnose-check", "--effects", "fibre_viscoelastic", "bogus"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "'bogus'" in err and "fibre_viscoelastic" in err
+
+
+@pytest.mark.parametrize(
+    "package", ["labstand", "drivers", "recordings", "sim", "sim.effects", "sim.hardware"]
+)
+def test_importing_a_package_loads_no_heavy_module(package: str) -> None:
+    # their re-exports are lazy (PEP 562): `import sim.errors` must not pay for the model
+    probe = (
+        f"import sys, {package}\n"
+        f"print(sorted({{m.split('.')[0] for m in sys.modules}} & set({HEAVY!r})))"
+    )
+    res = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, check=True)
+    assert res.stdout.strip() == "[]"
+
+
+def test_lazy_re_exports_are_the_real_objects() -> None:
+    import recordings
+    import sim
+    import sim.effects
+    from recordings.recording import open_recording
+    from sim.effects.registry import EFFECTS
+    from sim.model import Model
+
+    assert sim.Model is Model and recordings.open_recording is open_recording
+    assert sim.effects.EFFECTS is EFFECTS
+    assert recordings.csvio.read_csv is not None  # a submodule, imported on first use
+    with pytest.raises(AttributeError, match="no attribute 'Nope'"):
+        _ = sim.Nope  # type: ignore[attr-defined]
