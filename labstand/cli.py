@@ -21,7 +21,6 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any, NoReturn
 
 from drivers.limits import LimitError
-from labstand import __version__
 from labstand.errors import CommandError, ExitCode
 from recordings.errors import RecordingError
 from sim.errors import SimulationError
@@ -69,6 +68,16 @@ class _Commands(_SubParsers):
         return super().add_parser(name, **kwargs)
 
 
+class _Version(argparse.Action):
+    """--version, reading the installed version only when asked (importlib.metadata)."""
+
+    def __call__(self, parser: argparse.ArgumentParser, *_: object, **__: object) -> None:
+        import labstand
+
+        print(f"labstand {labstand.__version__}")
+        parser.exit()
+
+
 def command_module(name: str) -> str:
     """The module that implements sub-command ``name``."""
     module = name.replace("-", "_")
@@ -86,7 +95,7 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
         prog="labstand",
         description="Run the fibre stand, record it, and compare it with the model.",
     )
-    parser.add_argument("--version", action="version", version=f"labstand {__version__}")
+    parser.add_argument("--version", action=_Version, nargs=0, help="show the version and exit")
     parser.add_argument("-v", "--verbose", action="store_true", help="log details to stderr")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True, action=_Commands)
     for name in COMMANDS:
