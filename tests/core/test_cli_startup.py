@@ -133,3 +133,8 @@ def test_lazy_re_exports_are_the_real_objects() -> None:
     assert recordings.csvio.read_csv is not None  # a submodule, imported on first use
     with pytest.raises(AttributeError, match="no attribute 'Nope'"):
         _ = sim.Nope  # type: ignore[attr-defined]
+
+
+def test_version_goes_to_stdout() -> None:
+    res = subprocess.run([EXE, "--version"], capture_output=True, text=True, check=True)
+    assert res.stdout.startswith("labstand ") and res.stderr == ""
