@@ -62,7 +62,7 @@ def run(args: argparse.Namespace) -> int:
         freq = "" if r["frequency_hz"] is None else f"{r['frequency_hz']:g}"
         print(
             f"| {Path(r['recording']).name} | {r['signal']} | {freq} | {f['R_u']:.6f} | "
-            f"{s['R_u']:.6f} | {f['R_F_dyn']:.5f} | {s['R_F_dyn']:.5f} | {s['nrmse_u']:.4f} | "
+            f"{s['R_u']:.6f} | {f['R_F_dyn']:.6f} | {s['R_F_dyn']:.6f} | {s['nrmse_u']:.4f} | "
             f"{s['nrmse_F']:.4f} |"
         )
     return 0

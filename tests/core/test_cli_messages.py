@@ -100,3 +100,15 @@ def test_replay_plots_of_recordings_with_one_stem_do_not_overwrite(tmp_path: Pat
 
     paths = plot_paths(tmp_path / "r.png", [Path("a/s11.mcap"), Path("b/s11.mcap"), Path("c.h5")])
     assert [p.name for p in paths] == ["r-s11-1.png", "r-s11-2.png", "r-c.png"]
+
+
+def test_table1_gives_every_r_with_six_decimals(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    rec = tmp_path / "s11.csv"
+    assert main(["simulate", "--situation", "11", "-o", str(rec)]) == 0
+    capsys.readouterr()
+    assert main(["table1", str(rec)]) == 0
+    row = capsys.readouterr().out.splitlines()[-1].split("|")[1:-1]
+    r_cells = [c.strip() for c in row[3:7]]  # R(u) and R(F) for both parameter sets
+    assert all(len(c.split(".")[1]) == 6 for c in r_cells), r_cells
