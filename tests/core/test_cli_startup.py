@@ -138,3 +138,17 @@ def test_lazy_re_exports_are_the_real_objects() -> None:
 def test_version_goes_to_stdout() -> None:
     res = subprocess.run([EXE, "--version"], capture_output=True, text=True, check=True)
     assert res.stdout.startswith("labstand ") and res.stderr == ""
+
+
+def test_info_reads_an_mcap_without_the_model_or_other_formats(tmp_path: Path) -> None:
+    rec = tmp_path / "s11.mcap"
+    assert main(["simulate", "--situation", "11", "-o", str(rec)]) == 0
+    res = subprocess.run(
+        [sys.executable, "-X", "importtime", str(EXE), "info", str(rec)],
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    assert "8001 samples" in res.stdout
+    imported = {line.split("|")[-1].strip().split(".")[0] for line in res.stderr.splitlines()}
+    assert imported & set(HEAVY) == {"mcap"}  # its own reader, nothing else heavy
