@@ -13,6 +13,8 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
+from recordings.errors import RecordingError
+
 __all__ = ["written_whole"]
 
 
@@ -22,7 +24,8 @@ def written_whole(path: Path, suffix: str = "") -> Iterator[Path]:
 
     ``suffix`` is appended to the temporary name (writers that pick their format by the
     suffix need ``path``'s own). Any OSError (no such folder, disk full, no permission)
-    becomes ``OSError("PATH: cannot write: reason")``; the temporary file is removed.
+    becomes ``OSError("PATH: cannot write: reason")``, a RecordingError that names the
+    temporary file names ``path`` instead; the temporary file is removed.
     """
     tmp = path.with_name(path.name + ".part" + suffix)
     try:
@@ -30,6 +33,10 @@ def written_whole(path: Path, suffix: str = "") -> Iterator[Path]:
         os.replace(tmp, path)
     except OSError as err:
         raise OSError(f"{path}: cannot write: {_reason(path, tmp, err)}") from err
+    except RecordingError as err:  # a writer's check names the file it writes: the user's
+        if str(tmp) not in str(err):
+            raise
+        raise type(err)(str(err).replace(str(tmp), str(path))) from err
     finally:
         with contextlib.suppress(OSError):  # never there, or its folder is not one
             tmp.unlink(missing_ok=True)

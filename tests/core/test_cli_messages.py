@@ -112,3 +112,23 @@ def test_table1_gives_every_r_with_six_decimals(
     row = capsys.readouterr().out.splitlines()[-1].split("|")[1:-1]
     r_cells = [c.strip() for c in row[3:7]]  # R(u) and R(F) for both parameter sets
     assert all(len(c.split(".")[1]) == 6 for c in r_cells), r_cells
+
+
+@pytest.mark.parametrize("suffix", [".mcap", ".h5"])
+def test_a_writers_data_check_names_the_users_path(tmp_path: Path, suffix: str) -> None:
+    import numpy as np
+
+    from recordings.convert import write_streams
+    from recordings.errors import InvalidDataError
+    from recordings.schema import GAUGES_DTYPE, make_metadata
+    from sim.config import default_config
+
+    meta = make_metadata(default_config().to_dict(), "simulate")
+    gauges = np.zeros(4, GAUGES_DTYPE)
+    gauges["t_ns"] = np.arange(4) * 500_000
+    gauges["seq"] = np.arange(4)
+    target = tmp_path / f"x{suffix}"
+    with pytest.raises(InvalidDataError) as exc:
+        write_streams(target, meta, gauges, events=[(0, "", "an event without a kind")])
+    assert str(exc.value).startswith(f"{target}: ") and ".part" not in str(exc.value)
+    assert list(tmp_path.iterdir()) == []
