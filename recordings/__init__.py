@@ -25,6 +25,8 @@ from typing import TYPE_CHECKING, Any
 
 # Lazy re-exports (PEP 562): importing one module of the package (``recordings.errors``,
 # say) must not load the heavy ones (numba, scipy, pandas, h5py, ...) through it.
+# A name here must not name both an object and a submodule (importing the submodule
+# would rebind it to the module): sim.identify, whose ``diagnose`` is both, stays eager.
 _EXPORTS = {
     "csvio": "recordings.csvio",
     "hdf5io": "recordings.hdf5io",

@@ -17,6 +17,8 @@ from typing import TYPE_CHECKING, Any
 
 # Lazy re-exports (PEP 562): importing one module of the package (``sim.errors``,
 # say) must not load the heavy ones (numba, scipy, pandas, h5py, ...) through it.
+# A name here must not name both an object and a submodule (importing the submodule
+# would rebind it to the module): sim.identify, whose ``diagnose`` is both, stays eager.
 _EXPORTS = {
     "ConfigError": "sim.config",
     "ParameterSet": "sim.config",
