@@ -25,12 +25,15 @@ import itertools
 import math
 from dataclasses import dataclass, field
 from enum import StrEnum
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.interpolate import PPoly
 
 from drivers.limits import DriveLimits, LimitError
+
+if TYPE_CHECKING:
+    from scipy.interpolate import PPoly
 
 FloatArray = NDArray[np.float64]
 
@@ -177,6 +180,8 @@ def _check_spec(spec: SignalSpec, limits: DriveLimits) -> None:
 
 def _levels_ppoly(breaks: list[float], coeffs: list[tuple[float, float]]) -> PPoly:
     """Piecewise-linear PPoly; coeffs are (slope, value at the left break) per interval."""
+    from scipy.interpolate import PPoly  # scipy costs 0.3 s: not for `labstand CMD --help`
+
     c = np.array([[s for s, _ in coeffs], [v for _, v in coeffs]], dtype=np.float64)
     return PPoly(c, np.asarray(breaks, dtype=np.float64), extrapolate=True)
 

@@ -1,45 +1,51 @@
 """The ``labstand`` command: argument parsing and the one place errors become exit codes.
 
-Each sub-command lives in ``labstand/commands/<name>.py`` and exposes
+Each sub-command lives in ``labstand/commands/<module>.py`` and exposes
 ``register(subparsers)``, which adds its parser and sets ``func(args) -> int``.
+
+Start-up stays quick (docs/benchmarks.md): the top-level ``--help`` is built from the
+static ``COMMANDS`` table alone, and only the chosen command's module is imported; the
+command modules import their heavy parts (numba, scipy, pandas, matplotlib, h5py, ...)
+inside the function that runs the command.
 """
 
 from __future__ import annotations
 
 import argparse
 import importlib
+import keyword
 import logging
 import os
 import sys
 from collections.abc import Sequence
-from typing import NoReturn
+from typing import TYPE_CHECKING, Any, NoReturn
 
 from drivers.limits import LimitError
-from labstand import __version__
 from labstand.errors import CommandError, ExitCode
 from recordings.errors import RecordingError
-from sim.config import ConfigError
 from sim.errors import SimulationError
 
-#: Sub-command modules, in the order ``--help`` lists them.
-COMMANDS = [
-    "simulate",
-    "model",
-    "stand_sim",
-    "run",
-    "replay",
-    "play",
-    "compare",
-    "table1",
-    "info",
-    "import_",
-    "convert",
-    "cat",
-    "trim",
-    "recover",
-    "diagnose",
-    "diagnose_check",
-]
+#: Sub-commands, in the order ``--help`` lists them: name → one-line help. A command
+#: NAME lives in ``labstand.commands.NAME`` ("-" → "_", a Python keyword gets a "_"
+#: suffix: ``import`` → ``import_``); adding one is one line here.
+COMMANDS: dict[str, str] = {
+    "simulate": "simulate a run with the baseline model",
+    "model": "properties of the baseline model",
+    "stand-sim": "run the simulated stand (Modbus drive + 2 kHz gauges) on its own",
+    "run": "run a test on the stand (or the simulated stand) and record it",
+    "replay": "feed recordings' drive motion into the model and compare",
+    "play": "play a recording to Foxglove (WebSocket), with the model beside it",
+    "compare": "compare two recordings (e.g. two runs of one situation)",
+    "table1": "Table 1 of the paper: R per channel for two parameter sets",
+    "info": "duration, channels, rates, lost samples and metadata of a recording",
+    "import": "import a CSV or TDMS run as a recording",
+    "convert": "convert a recording into MCAP, HDF5, CSV or Parquet",
+    "cat": "print samples or events of a time window as CSV text",
+    "trim": "cut a time window out of a recording into a new one",
+    "recover": "recover a recording whose writer was killed",
+    "diagnose": "find which unmodelled effect explains the gap between model and recordings",
+    "diagnose-check": "score the diagnosis on generated recordings whose effect is withheld",
+}
 
 log = logging.getLogger("labstand")
 
@@ -51,18 +57,66 @@ class _Parser(argparse.ArgumentParser):
         self.exit(2, f"{self.prog}: error: {message} (see '{self.prog} --help')\n")
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """The full argument parser (all sub-commands)."""
+if TYPE_CHECKING:
+    _SubParsers = argparse._SubParsersAction[argparse.ArgumentParser]
+else:  # not subscriptable at run time
+    _SubParsers = argparse._SubParsersAction
+
+
+class _Commands(_SubParsers):
+    """The sub-command action: a command's one-line help comes from ``COMMANDS``."""
+
+    def add_parser(self, name: str, **kwargs: Any) -> argparse.ArgumentParser:
+        kwargs.setdefault("help", COMMANDS.get(name))
+        return super().add_parser(name, **kwargs)
+
+
+class _Version(argparse.Action):
+    """--version, reading the installed version only when asked (importlib.metadata)."""
+
+    def __call__(self, parser: argparse.ArgumentParser, *_: object, **__: object) -> None:
+        import labstand
+
+        print(f"labstand {labstand.__version__}")
+        parser.exit()
+
+
+def command_module(name: str) -> str:
+    """The module that implements sub-command ``name``."""
+    module = name.replace("-", "_")
+    return f"labstand.commands.{module}{'_' if keyword.iskeyword(module) else ''}"
+
+
+def build_parser(command: str | None = None) -> argparse.ArgumentParser:
+    """The argument parser, with ``command``'s full sub-parser (all of them if None).
+
+    The other sub-commands get a stub (name and one-line help) so that the top-level
+    ``--help`` lists them and a mistyped name is refused with the list of choices,
+    without importing their modules.
+    """
     parser = _Parser(
         prog="labstand",
         description="Run the fibre stand, record it, and compare it with the model.",
     )
-    parser.add_argument("--version", action="version", version=f"labstand {__version__}")
+    parser.add_argument("--version", action=_Version, nargs=0, help="show the version and exit")
     parser.add_argument("-v", "--verbose", action="store_true", help="log details to stderr")
-    sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True, action=_Commands)
     for name in COMMANDS:
-        importlib.import_module(f"labstand.commands.{name}").register(sub)
+        if command is None or name == command:
+            importlib.import_module(command_module(name)).register(sub)
+        else:
+            sub.add_parser(name, add_help=False)
     return parser
+
+
+def _chosen(words: Sequence[str]) -> str | None:
+    """The sub-command named in ``words`` (the first word that is not an option)."""
+    for word in words:
+        if word == "--":
+            return None
+        if not word.startswith("-"):
+            return word if word in COMMANDS else None
+    return None
 
 
 _PREFIXES = {
@@ -77,7 +131,8 @@ def _error_code(err: Exception) -> ExitCode:
         return err.code
     if isinstance(err, LimitError):
         return ExitCode.REFUSED
-    if isinstance(err, ConfigError | SimulationError | RecordingError | ValueError):
+    # ConfigError (sim.config, not imported here: it pulls scipy) is a ValueError too.
+    if isinstance(err, SimulationError | RecordingError | ValueError):
         return ExitCode.USAGE
     return ExitCode.FAILURE
 
@@ -97,12 +152,13 @@ def _subparser(parser: argparse.ArgumentParser, name: str | None) -> argparse.Ar
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run labstand with argv (without the program name); returns the exit code."""
-    parser = build_parser()
     words = list(sys.argv[1:] if argv is None else argv)
     # -v / --verbose anywhere, before or after the sub-command (up to a "--").
     end = words.index("--") if "--" in words else len(words)
     verbose = any(w in ("-v", "--verbose") for w in words[:end])
     words = [w for i, w in enumerate(words) if i >= end or w not in ("-v", "--verbose")]
+    # Only the chosen command's module is imported ("": none, for the top-level --help).
+    parser = build_parser(_chosen(words) or "")
     args, extra = parser.parse_known_args(words)
     if extra:  # name the command whose --help would have told
         command = _subparser(parser, getattr(args, "command", None)) or parser
@@ -126,7 +182,6 @@ def main(argv: Sequence[str] | None = None) -> int:
     except (
         CommandError,
         LimitError,
-        ConfigError,
         SimulationError,
         RecordingError,
         OSError,

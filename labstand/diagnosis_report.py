@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from labstand.plots import pyplot
+from labstand.plots import pyplot, r_text
 from sim.identify import Diagnosis, Trace
 from sim.identify.traces import PHASES
 
@@ -19,7 +19,11 @@ PHASE_COLOURS = {"rise": "tab:red", "hold": "tab:orange", "fall": "tab:blue", "r
 def _residual_plot(path: Path, traces: Sequence[Trace], result: Diagnosis) -> None:
     plt = pyplot()
     fig, axes = plt.subplots(
-        2 * len(traces), 1, figsize=(11, 3.2 * len(traces)), squeeze=False, constrained_layout=True
+        2 * len(traces),
+        1,
+        figsize=(11, 3.2 * len(traces) + 0.4),
+        squeeze=False,
+        layout="constrained",
     )
     for i, (tr, out) in enumerate(zip(traces, result.outputs_before, strict=True)):
         t = np.arange(tr.samples) / tr.rate_hz
@@ -42,12 +46,12 @@ def _residual_plot(path: Path, traces: Sequence[Trace], result: Diagnosis) -> No
                 label="held out",
             )
             ax.set_ylabel(f"{name} residual [{unit}]")
-            ax.set_title(f"{tr.name}: fitted baseline − recorded", fontsize=9)
+            ax.set_title(f"{tr.name}: fitted baseline − recorded", fontsize=10)
             ax.grid(alpha=0.3)
-            if i == 0 and j == 0:
-                ax.legend(markerscale=12, fontsize=8, ncol=5, loc="upper right")
     axes[-1, 0].set_xlabel("time [s]")
-    fig.savefig(path, dpi=90)
+    handles, labels = axes[0, 0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="outside upper center", ncol=5, markerscale=12, fontsize=10)
+    fig.savefig(path, dpi=100)
     plt.close(fig)
 
 
@@ -74,8 +78,11 @@ def _ranking_plot(path: Path, result: Diagnosis) -> None:
     plt.close(fig)
 
 
-#: Width of the zoomed window around the largest residual, s.
-ZOOM_S = 0.4
+#: Width of the zoomed window around the largest residual, s: narrow enough that a gap of
+#: a few tenths of a millimetre on a 30 mm stroke is visible at the window's own scale.
+ZOOM_S = 0.12
+#: Colours shared by every panel (one legend for the figure).
+RECORDED, BASELINE, AUGMENTED = "k", "tab:blue", "tab:red"
 
 
 def _overlay_plot(path: Path, traces: Sequence[Trace], result: Diagnosis) -> None:
@@ -83,15 +90,18 @@ def _overlay_plot(path: Path, traces: Sequence[Trace], result: Diagnosis) -> Non
 
     Recorded, baseline and augmented lie within a fraction of a line width of each other
     at full scale; the residuals (model − recorded) and a window around the baseline's
-    largest residual show the difference a person is looking for.
+    largest residual (shaded in the residual panel) show the difference a person is
+    looking for.
     """
     plt = pyplot()
+    from matplotlib.lines import Line2D
+
     fig, axes = plt.subplots(
         2 * len(traces),
         2,
-        figsize=(12, 3.0 * len(traces)),
+        figsize=(12, 3.2 * len(traces) + 0.5),
         squeeze=False,
-        constrained_layout=True,
+        layout="constrained",
         gridspec_kw={"width_ratios": [2.2, 1]},
     )
     named = " + ".join(e.effect for e in result.effects)
@@ -107,30 +117,41 @@ def _overlay_plot(path: Path, traces: Sequence[Trace], result: Diagnosis) -> Non
             res_b = np.where(tr.present, b - rec, np.nan) * scale
             res_a = np.where(tr.present, a - rec, np.nan) * scale
             ax = axes[2 * i + j, 0]
-            ax.plot(t, res_b, color="tab:blue", lw=0.6, label="baseline − recorded")
+            ax.plot(t, res_b, color=BASELINE, lw=0.6)
             if named:
-                ax.plot(t, res_a, color="tab:red", lw=0.6, label=f"+ {named} − recorded")
+                ax.plot(t, res_a, color=AUGMENTED, lw=0.6)
             ax.axhline(0.0, color="k", lw=0.5)
-            ax.set_ylabel(f"{name} residual [{unit}]")
-            ax.set_title(f"{tr.name}: residual of {name}", fontsize=9)
+            ax.set_ylabel(f"Δ{name} [{unit}]")
+            ax.set_title(
+                f"{tr.name}: {name}, model − recorded (shaded: the window on the right)",
+                fontsize=10,
+            )
             ax.grid(alpha=0.3)
-            ax.legend(fontsize=7, loc="upper right")
-            # The window around the baseline's largest residual, at full scale.
+            # The window around the baseline's largest residual, at its own scale.
             k = int(np.nanargmax(np.abs(res_b))) if np.isfinite(res_b).any() else 0
             half = int(ZOOM_S / 2 * tr.rate_hz)
             win = slice(max(0, k - half), min(tr.samples, k + half))
+            ax.axvspan(t[win][0], t[win][-1], color="gold", alpha=0.35, lw=0)
             zoom = axes[2 * i + j, 1]
-            zoom.plot(t[win], rec[win] * scale, color="k", lw=1.0, label="recorded")
-            zoom.plot(t[win], b[win] * scale, color="tab:blue", lw=0.9, ls="--", label="baseline")
+            zoom.plot(t[win], rec[win] * scale, color=RECORDED, lw=1.2)
+            zoom.plot(t[win], b[win] * scale, color=BASELINE, lw=1.1, ls="--")
             if named:
-                zoom.plot(t[win], a[win] * scale, color="tab:red", lw=0.9, ls=":", label=named)
+                zoom.plot(t[win], a[win] * scale, color=AUGMENTED, lw=1.1, ls=":")
             zoom.set_ylabel(f"{name} [{unit}]")
-            zoom.set_title(f"where the baseline misses most (t = {t[k]:.2f} s)", fontsize=9)
+            zoom.set_title(
+                f"largest baseline miss: {res_b[k]:+.3g} {unit} at t = {t[k]:.3f} s", fontsize=10
+            )
             zoom.grid(alpha=0.3)
-            zoom.legend(fontsize=7, loc="best")
-    axes[-1, 0].set_xlabel("time [s]")
-    axes[-1, 1].set_xlabel("time [s]")
-    fig.savefig(path, dpi=90)
+    for ax in axes[-1]:
+        ax.set_xlabel("time [s]")
+    handles = [
+        Line2D([], [], color=RECORDED, lw=1.2, label="recorded"),
+        Line2D([], [], color=BASELINE, lw=1.1, ls="--", label="fitted baseline"),
+    ]
+    if named:
+        handles.append(Line2D([], [], color=AUGMENTED, lw=1.1, ls=":", label=f"+ {named}"))
+    fig.legend(handles=handles, loc="outside upper center", ncol=len(handles), fontsize=10)
+    fig.savefig(path, dpi=100)
     plt.close(fig)
 
 
@@ -141,11 +162,11 @@ def _table(rows: Mapping[str, object]) -> str:
     return f"<table>{cells}</table>"
 
 
-def _fmt(value: object) -> str:
+def _fmt(value: object, key: object = None) -> str:
     if isinstance(value, float):
-        return f"{value:.4g}"
+        return r_text(value) if key == "R" else f"{value:.4g}"
     if isinstance(value, dict):
-        return ", ".join(f"{html.escape(str(k))} {_fmt(v)}" for k, v in value.items())
+        return ", ".join(f"{html.escape(str(k))} {_fmt(v, k)}" for k, v in value.items())
     return html.escape(str(value))
 
 

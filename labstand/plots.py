@@ -4,11 +4,21 @@ from __future__ import annotations
 
 from pathlib import Path
 from types import ModuleType
+from typing import TYPE_CHECKING, cast
 
-from recordings.replay import ReplayResult
-from sim.results import SimResult
+if TYPE_CHECKING:  # matplotlib is imported when a plot is drawn, not with this module
+    from matplotlib.figure import Figure
+
+    from recordings.replay import ReplayResult
+    from sim.results import SimResult
 
 _UNITS = {"u": "weight u [mm]", "F": "fibre force F [N]", "F_dyn": "dynamic force F − T₀ [N]"}
+_RESIDUAL_UNITS = {"u": "Δu [mm]", "F": "ΔF [N]", "F_dyn": "Δ(F − T₀) [N]"}
+
+
+def r_text(r: float) -> str:
+    """R as the paper prints it: six decimals (0.999961); rounding to 4 would hide the gap."""
+    return f"{r:.6f}"
 
 
 def pyplot() -> ModuleType:
@@ -23,6 +33,13 @@ def pyplot() -> ModuleType:
 
 def plot_run(path: Path, result: SimResult, title: str) -> None:
     """Drive position, weight displacement and fibre force over time, one panel each."""
+    fig = run_figure(result, title)
+    fig.savefig(path, dpi=110)
+    pyplot().close(fig)
+
+
+def run_figure(result: SimResult, title: str) -> Figure:
+    """The figure of ``plot_run``."""
     plt = pyplot()
 
     fig, axes = plt.subplots(3, 1, sharex=True, figsize=(10, 7), constrained_layout=True)
@@ -49,8 +66,7 @@ def plot_run(path: Path, result: SimResult, title: str) -> None:
     for ax in axes:
         ax.grid(alpha=0.3)
     fig.suptitle(title)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    return cast("Figure", fig)  # pyplot() is a plain module to mypy
 
 
 def plot_replay(
@@ -61,6 +77,15 @@ def plot_replay(
     first_label: str = "recorded",
 ) -> None:
     """Recorded vs simulated u and F − T₀ (like the paper's figures), with the residuals."""
+    fig = replay_figure(result, title, second_label, first_label)
+    fig.savefig(path, dpi=110)
+    pyplot().close(fig)
+
+
+def replay_figure(
+    result: ReplayResult, title: str, second_label: str = "simulated", first_label: str = "recorded"
+) -> Figure:
+    """The figure of ``plot_replay``."""
     plt = pyplot()
 
     channels = ("u", "F_dyn")
@@ -80,14 +105,18 @@ def plot_replay(
         ax.plot(t, rec, color="k", lw=0.9, label=first_label)
         ax.plot(t, sim, color="tab:red", lw=0.9, ls="--", label=second_label)
         ax.set_ylabel(_UNITS[name])
-        ax.set_title(f"{name}: R = {m.R:.4f}, ψ = {m.psi:.3g}, NRMSE = {m.nrmse:.3f}", fontsize=9)
-        ax.legend(loc="upper right", fontsize=8)
-        res_ax.plot(t, sim - rec, color="tab:purple", lw=0.7)
+        ax.set_title(
+            f"{name}: R = {r_text(m.R)}, ψ = {m.psi:.3g}, NRMSE = {m.nrmse:.4f}", fontsize=10
+        )
+        ax.legend(loc="upper right", fontsize=9, framealpha=0.9)
+        res_ax.plot(
+            t, sim - rec, color="tab:purple", lw=0.7, label=f"{second_label} − {first_label}"
+        )
         res_ax.axhline(0, color="k", lw=0.4)
-        res_ax.set_ylabel("residual")
+        res_ax.set_ylabel(_RESIDUAL_UNITS[name])
+        res_ax.legend(loc="best", fontsize=9, framealpha=0.9)
     for ax in axes:
         ax.grid(alpha=0.3)
     axes[-1].set_xlabel("time [s]")
     fig.suptitle(title)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    return cast("Figure", fig)  # pyplot() is a plain module to mypy

@@ -20,31 +20,82 @@ Exceptions::
           └── WindowError             a time window outside the recording (recordings.window)
 """
 
-from recordings import csvio, hdf5io, mcap_reader, mcap_writer, tables, tdmsio
-from recordings.base import RecordingWriter, open_writer
-from recordings.errors import (
-    CorruptRecordingError,
-    ImportMappingError,
-    InvalidDataError,
-    MissingChannelError,
-    RecordingError,
-    SchemaVersionError,
-    TruncatedRecordingError,
-    UnknownFormatError,
-    WriterClosedError,
-)
-from recordings.recording import Recording, open_recording
-from recordings.schema import (
-    COMMAND_DTYPE,
-    DRIVE_DTYPE,
-    GAUGES_DTYPE,
-    SCHEMA_VERSION,
-    Backend,
-    Effect,
-    RecordingMetadata,
-    make_metadata,
-    unwrap_u16,
-)
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
+
+# Lazy re-exports (PEP 562): importing one module of the package (``recordings.errors``,
+# say) must not load the heavy ones (numba, scipy, pandas, h5py, ...) through it.
+# A name here must not name both an object and a submodule (importing the submodule
+# would rebind it to the module): sim.identify, whose ``diagnose`` is both, stays eager.
+_EXPORTS = {
+    "csvio": "recordings.csvio",
+    "hdf5io": "recordings.hdf5io",
+    "mcap_reader": "recordings.mcap_reader",
+    "mcap_writer": "recordings.mcap_writer",
+    "tdmsio": "recordings.tdmsio",
+    "tables": "recordings.tables",
+    "RecordingWriter": "recordings.base",
+    "open_writer": "recordings.base",
+    "CorruptRecordingError": "recordings.errors",
+    "ImportMappingError": "recordings.errors",
+    "InvalidDataError": "recordings.errors",
+    "MissingChannelError": "recordings.errors",
+    "RecordingError": "recordings.errors",
+    "SchemaVersionError": "recordings.errors",
+    "TruncatedRecordingError": "recordings.errors",
+    "UnknownFormatError": "recordings.errors",
+    "WriterClosedError": "recordings.errors",
+    "Recording": "recordings.recording",
+    "open_recording": "recordings.recording",
+    "COMMAND_DTYPE": "recordings.schema",
+    "DRIVE_DTYPE": "recordings.schema",
+    "GAUGES_DTYPE": "recordings.schema",
+    "SCHEMA_VERSION": "recordings.schema",
+    "Backend": "recordings.schema",
+    "Effect": "recordings.schema",
+    "RecordingMetadata": "recordings.schema",
+    "make_metadata": "recordings.schema",
+    "unwrap_u16": "recordings.schema",
+}
+
+if TYPE_CHECKING:
+    from recordings import csvio, hdf5io, mcap_reader, mcap_writer, tdmsio
+    from recordings.base import RecordingWriter, open_writer
+    from recordings.errors import (
+        CorruptRecordingError,
+        ImportMappingError,
+        InvalidDataError,
+        MissingChannelError,
+        RecordingError,
+        SchemaVersionError,
+        TruncatedRecordingError,
+        UnknownFormatError,
+        WriterClosedError,
+    )
+    from recordings.recording import Recording, open_recording
+    from recordings.schema import (
+        COMMAND_DTYPE,
+        DRIVE_DTYPE,
+        GAUGES_DTYPE,
+        SCHEMA_VERSION,
+        Backend,
+        Effect,
+        RecordingMetadata,
+        make_metadata,
+        unwrap_u16,
+    )
+
+
+def __getattr__(name: str) -> Any:
+    module = _EXPORTS.get(name)
+    if module is None:
+        raise AttributeError(f"module 'recordings' has no attribute {name!r}")
+    if module == f"{__name__}.{name}":  # a submodule
+        return importlib.import_module(module)
+    return getattr(importlib.import_module(module), name)
+
 
 __all__ = [
     "COMMAND_DTYPE",

@@ -8,6 +8,7 @@ killed process loses at most the last second. A writer is thread-confined: one t
 
 from __future__ import annotations
 
+import importlib
 import logging
 import math
 import time
@@ -35,6 +36,7 @@ __all__ = [
     "FORMATS",
     "RecordingWriter",
     "check_stream",
+    "formats",
     "open_writer",
     "reader_for",
     "register_format",
@@ -226,8 +228,20 @@ class RecordingWriter(ClosesOnExit, ABC):
 WriterFactory = Callable[[Path, RecordingMetadata], RecordingWriter]
 ReaderFunction = Callable[..., Any]  # (path, *, salvage=False) -> Recording
 
-#: suffix -> (format name, writer class or None, reader function or None)
+#: suffix -> (format name, writer class or None, reader function or None), filled by the
+#: format modules as they are imported (``register_format``); ``formats()`` imports them all.
 FORMATS: dict[str, tuple[str, WriterFactory | None, ReaderFunction | None]] = {}
+
+#: suffix -> the modules that register its reader and writer. A format module is imported
+#: only when a file of its suffix is opened, so reading an MCAP file does not load h5py
+#: and nptdms (the command's start-up time, docs/benchmarks.md).
+FORMAT_MODULES: dict[str, tuple[str, ...]] = {
+    ".csv": ("recordings.csvio",),
+    ".mcap": ("recordings.mcap_reader", "recordings.mcap_writer"),
+    ".h5": ("recordings.hdf5io",),
+    ".hdf5": ("recordings.hdf5io",),
+    ".tdms": ("recordings.tdmsio",),
+}
 
 
 def register_format(
@@ -242,11 +256,21 @@ def register_format(
         FORMATS[suffix] = (name, writer or old_writer, reader or old_reader)
 
 
+def formats() -> dict[str, tuple[str, WriterFactory | None, ReaderFunction | None]]:
+    """Every known format (``FORMATS``, after importing all format modules)."""
+    for modules in FORMAT_MODULES.values():
+        for module in modules:
+            importlib.import_module(module)
+    return FORMATS
+
+
 def _lookup(path: Path, role: str) -> tuple[str, WriterFactory | None, ReaderFunction | None]:
     suffix = path.suffix.lower()
+    for module in FORMAT_MODULES.get(suffix, ()):
+        importlib.import_module(module)
     entry = FORMATS.get(suffix)
-    usable = sorted(s for s, e in FORMATS.items() if e[1 if role == "write" else 2] is not None)
     if entry is None or entry[1 if role == "write" else 2] is None:
+        usable = sorted(s for s, e in formats().items() if e[1 if role == "write" else 2])
         raise UnknownFormatError(
             f"{path}: cannot {role} {suffix or 'files without a suffix'!r}; "
             f"use one of {', '.join(usable)}"

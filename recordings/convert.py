@@ -10,10 +10,10 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from recordings.atomic import written_whole
 from recordings.base import EVENTS_DTYPE, open_writer
 from recordings.recording import Recording
 from recordings.schema import COMMAND_DTYPE, DRIVE_DTYPE, RecordingMetadata
-from recordings.tables import TABLE_SUFFIXES, write_table
 
 __all__ = ["summary", "with_changes", "write_recording", "write_streams"]
 
@@ -33,38 +33,34 @@ def write_streams(
 ) -> None:
     """Write whole streams in time order, block by block, as a live run would.
 
-    Writes to ``path.part`` and renames at the end, so a failed write leaves no stub.
+    Writes to a temporary name and renames at the end, so a failed write leaves no stub;
+    an error names ``path`` (``recordings.atomic``).
     """
     command = command if command is not None else np.empty(0, COMMAND_DTYPE)
     drive = drive if drive is not None else np.empty(0, DRIVE_DTYPE)
     pending_events = sorted(events or [], key=lambda e: e[0])
-    tmp = path.with_name(path.name + ".part" + path.suffix)
-    try:
-        with open_writer(tmp, metadata) as writer:
-            g_at = c_at = d_at = e_at = 0
-            while g_at < len(gauges) or c_at < len(command):
-                # the next second of the clock, in whichever stream is behind
-                t_end = _next_end(gauges, g_at, command, c_at)
-                g_to = int(np.searchsorted(gauges["t_ns"], t_end, side="right"))
-                c_to = int(np.searchsorted(command["t_ns"], t_end, side="right"))
-                d_to = int(np.searchsorted(drive["t_ns"], t_end, side="right"))
-                if g_to > g_at:
-                    writer.write_gauges(gauges[g_at:g_to])
-                if c_to > c_at:
-                    writer.write_command(command[c_at:c_to])
-                if d_to > d_at:
-                    writer.write_drive_state(drive[d_at:d_to])
-                while e_at < len(pending_events) and pending_events[e_at][0] <= t_end:
-                    writer.write_event(*pending_events[e_at])
-                    e_at += 1
-                g_at, c_at, d_at = g_to, c_to, d_to
-            if d_at < len(drive):
-                writer.write_drive_state(drive[d_at:])
-            for event in pending_events[e_at:]:
-                writer.write_event(*event)
-        tmp.replace(path)
-    finally:
-        tmp.unlink(missing_ok=True)
+    with written_whole(path, path.suffix) as tmp, open_writer(tmp, metadata) as writer:
+        g_at = c_at = d_at = e_at = 0
+        while g_at < len(gauges) or c_at < len(command):
+            # the next second of the clock, in whichever stream is behind
+            t_end = _next_end(gauges, g_at, command, c_at)
+            g_to = int(np.searchsorted(gauges["t_ns"], t_end, side="right"))
+            c_to = int(np.searchsorted(command["t_ns"], t_end, side="right"))
+            d_to = int(np.searchsorted(drive["t_ns"], t_end, side="right"))
+            if g_to > g_at:
+                writer.write_gauges(gauges[g_at:g_to])
+            if c_to > c_at:
+                writer.write_command(command[c_at:c_to])
+            if d_to > d_at:
+                writer.write_drive_state(drive[d_at:d_to])
+            while e_at < len(pending_events) and pending_events[e_at][0] <= t_end:
+                writer.write_event(*pending_events[e_at])
+                e_at += 1
+            g_at, c_at, d_at = g_to, c_to, d_to
+        if d_at < len(drive):
+            writer.write_drive_state(drive[d_at:])
+        for event in pending_events[e_at:]:
+            writer.write_event(*event)
 
 
 def _next_end(gauges: NDArray[np.void], g_at: int, command: NDArray[np.void], c_at: int) -> int:
@@ -89,7 +85,9 @@ def write_recording(
     for line in recording.repairs:
         t_ns = int(recording.gauges["t_ns"][-1]) if len(recording.gauges) else 0
         events.append((t_ns, "repair", line))
-    if path.suffix.lower() in TABLE_SUFFIXES:
+    if path.suffix.lower() in (".csv", ".parquet"):  # recordings.tables.TABLE_SUFFIXES
+        from recordings.tables import write_table  # pandas: only when a table is written
+
         array = np.array(events, dtype=EVENTS_DTYPE).reshape(len(events))
         write_table(dataclasses.replace(recording, events_array=array, repairs=[]), path, meta)
     else:

@@ -10,7 +10,6 @@ A preamble written by ``labstand convert`` (``# labstand-metadata: {...}`` and
 from __future__ import annotations
 
 import json
-import os
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -20,6 +19,7 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
+from recordings.atomic import written_whole
 from recordings.base import EVENTS_DTYPE, register_format
 from recordings.csvtext import CsvOptions, CsvText, split_csv
 from recordings.errors import CorruptRecordingError, ImportMappingError, RecordingError, shown
@@ -56,9 +56,8 @@ def write_csv(
 ) -> None:
     """Write the four columns; written to a temporary name first, so a crash leaves no stub."""
     table = np.column_stack([t_s, x_mm, u_mm, force_n])
-    tmp = path.with_name(path.name + ".part")
-    np.savetxt(tmp, table, delimiter=",", header=HEADER, comments="", fmt="%.9g")
-    os.replace(tmp, path)
+    with written_whole(path) as tmp:
+        np.savetxt(tmp, table, delimiter=",", header=HEADER, comments="", fmt="%.9g")
 
 
 def _numeric(

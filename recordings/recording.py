@@ -5,15 +5,17 @@ from __future__ import annotations
 import logging
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pandas as pd
 from numpy.typing import NDArray
 
 from recordings.base import EVENTS_DTYPE, check_stream, reader_for
 from recordings.errors import InvalidDataError
 from recordings.schema import COMMAND_DTYPE, DRIVE_DTYPE, GAUGES_DTYPE, RecordingMetadata
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 __all__ = ["FRAME_UNITS", "Recording", "open_recording"]
 
@@ -108,6 +110,8 @@ class Recording:
         ``u_mm``, ``F_N``, ``seq``, ``flags``; units in ``df.attrs["units"]``, the nominal
         rate in ``df.attrs["rate_hz"]``, the file in ``df.attrs["source"]``.
         """
+        import pandas as pd  # ~0.3 s: only for the callers that want a frame
+
         g = self.gauges
         index = pd.Index(g["t_ns"] / 1e9, name="t_s")
         df = pd.DataFrame(
@@ -129,6 +133,8 @@ class Recording:
 
     def drive_states(self) -> pd.DataFrame:
         """Drive polls, index ``t_s``; units in ``df.attrs["units"]``."""
+        import pandas as pd  # ~0.3 s: only for the callers that want a frame
+
         d = self.drive
         df = pd.DataFrame(
             {name: d[name] for name in DRIVE_DTYPE.names or () if name != "t_ns"},
@@ -139,6 +145,8 @@ class Recording:
 
     def events(self) -> pd.DataFrame:
         """Events, index ``t_s``; columns ``kind`` and ``text``."""
+        import pandas as pd  # ~0.3 s: only for the callers that want a frame
+
         e = self.events_array
         return pd.DataFrame(
             {"kind": e["kind"].astype(str), "text": e["text"].astype(str)},
@@ -159,7 +167,9 @@ class Recording:
         }
 
 
-def open_recording(path: str | Path, *, salvage: bool = False) -> Recording:
+def open_recording(
+    path: str | Path, *, salvage: bool = False, log_repairs: bool = True
+) -> Recording:
     """Read a recording (.mcap, .h5/.hdf5) or a foreign run (.csv, .tdms), checked.
 
     Parameters
@@ -170,6 +180,9 @@ def open_recording(path: str | Path, *, salvage: bool = False) -> Recording:
         Read what can be read from a damaged file (a truncated MCAP, an HDF5 file whose
         writer was killed) and list what was done in ``Recording.repairs``, instead of
         raising TruncatedRecordingError.
+    log_repairs
+        Log each repair as a warning (the default); callers that print
+        ``Recording.repairs`` themselves pass False, so the user reads each once.
 
     Raises
     ------
@@ -179,6 +192,6 @@ def open_recording(path: str | Path, *, salvage: bool = False) -> Recording:
     p = Path(path)
     recording: Recording = reader_for(p)(p, salvage=salvage)
     recording.check()
-    for line in recording.repairs:
+    for line in recording.repairs if log_repairs else ():
         log.warning("%s: %s", p, line)
     return recording

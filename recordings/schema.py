@@ -19,7 +19,6 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
 from enum import StrEnum
-from importlib.metadata import PackageNotFoundError, version
 from typing import Any
 
 import numpy as np
@@ -272,6 +271,8 @@ class RecordingMetadata:
 
 def software_version() -> str:
     """The installed labstand version (recordings may not import labstand itself)."""
+    from importlib.metadata import PackageNotFoundError, version  # imports email: lazily
+
     try:
         return version("labstand")
     except PackageNotFoundError:

@@ -10,10 +10,45 @@ Exceptions::
      └── SimulationError    unusable model input (non-finite, too short, bad effect)
 """
 
-from sim.config import ConfigError, ParameterSet, StandConfig, default_config, load_config
-from sim.errors import SimulationError
-from sim.model import BatchResult, Model, ModelRun, SimResult
-from sim.params import FrictionTable, StandParams
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
+
+# Lazy re-exports (PEP 562): importing one module of the package (``sim.errors``,
+# say) must not load the heavy ones (numba, scipy, pandas, h5py, ...) through it.
+# A name here must not name both an object and a submodule (importing the submodule
+# would rebind it to the module): sim.identify, whose ``diagnose`` is both, stays eager.
+_EXPORTS = {
+    "ConfigError": "sim.config",
+    "ParameterSet": "sim.config",
+    "StandConfig": "sim.config",
+    "default_config": "sim.config",
+    "load_config": "sim.config",
+    "SimulationError": "sim.errors",
+    "BatchResult": "sim.model",
+    "Model": "sim.model",
+    "ModelRun": "sim.model",
+    "SimResult": "sim.model",
+    "FrictionTable": "sim.params",
+    "StandParams": "sim.params",
+}
+
+if TYPE_CHECKING:
+    from sim.config import ConfigError, ParameterSet, StandConfig, default_config, load_config
+    from sim.errors import SimulationError
+    from sim.model import BatchResult, Model, ModelRun, SimResult
+    from sim.params import FrictionTable, StandParams
+
+
+def __getattr__(name: str) -> Any:
+    module = _EXPORTS.get(name)
+    if module is None:
+        raise AttributeError(f"module 'sim' has no attribute {name!r}")
+    if module == f"{__name__}.{name}":  # a submodule
+        return importlib.import_module(module)
+    return getattr(importlib.import_module(module), name)
+
 
 __all__ = [
     "BatchResult",

@@ -4,9 +4,10 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from sim.config import StandConfig, config_from_dict, load_config
+if TYPE_CHECKING:
+    from sim.config import StandConfig
 
 
 def add_stand_options(parser: argparse.ArgumentParser, params: bool = False) -> None:
@@ -25,6 +26,8 @@ def add_stand_options(parser: argparse.ArgumentParser, params: bool = False) -> 
 
 def load_stand(args: argparse.Namespace) -> StandConfig:
     """The stand configuration the user chose, validated."""
+    from sim.config import load_config  # scipy: only when a command runs
+
     return load_config(getattr(args, "stand", None))
 
 
@@ -43,5 +46,7 @@ def config_with_mass(config: StandConfig, mass_kg: float) -> dict[str, Any]:
         )
         weights[name] = mass_kg
     raw["weight"]["default"] = name
+    from sim.config import config_from_dict  # scipy: only when a command runs
+
     config_from_dict(raw, config.source)  # still valid
     return raw

@@ -6,17 +6,11 @@ import argparse
 import json
 from pathlib import Path
 
-from labstand.commands.replay import print_metrics
-from labstand.plots import plot_replay
-from recordings import open_recording
-from recordings.replay import compare_runs
-
 
 def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Add ``labstand compare``."""
     parser = sub.add_parser(
         "compare",
-        help="compare two recordings (e.g. two runs of one situation)",
         description="Compare recording B against recording A (aligned on the start of the "
         "drive motion): R, psi and NRMSE of u, F and F − T0.",
     )
@@ -29,6 +23,11 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Compare and report."""
+    from labstand.commands.replay import print_metrics
+    from labstand.plots import plot_replay
+    from recordings import open_recording
+    from recordings.replay import compare_runs
+
     a, b = open_recording(args.a), open_recording(args.b)
     result = compare_runs(a.frame(), b.frame())
     out = {"a": str(args.a), "b": str(args.b), **result.to_dict()}

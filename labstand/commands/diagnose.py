@@ -6,24 +6,22 @@ import argparse
 import json
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from labstand.campaigns import trace_of, unique_names
-from labstand.commands.diagnose_many import run_campaigns
-from labstand.diagnosis_report import write_report
 from labstand.distributed import add_cluster_options
 from labstand.errors import CommandError, ExitCode
-from recordings import RecordingError, open_recording
-from sim.config import ConfigError, StandConfig, config_from_dict, load_config
-from sim.identify import Diagnosis, DiagnosisInputError, diagnose
 
-__all__ = ["register", "run", "trace_of"]
+if TYPE_CHECKING:  # imported where they run: `diagnose --help` loads no numba or pandas
+    from sim.config import StandConfig
+    from sim.identify import Diagnosis
+
+__all__ = ["register", "run"]
 
 
 def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Add ``labstand diagnose``."""
     parser = sub.add_parser(
         "diagnose",
-        help="find which unmodelled effect explains the gap between model and recordings",
         description="Fit the baseline (stiffness, damping, friction scale) to one or more "
         "recordings of one stand, say where the remaining gap lies, which of the nine "
         "candidate effects explains it (judged on held-out cycles), and how far it shrinks.",
@@ -72,8 +70,12 @@ def _mass_of(
     if stand is not None:
         return stand.default_mass_kg, f"default weight of {stand.source}"
     try:
+        from sim.config import config_from_dict
+
         mass = config_from_dict(stored, str(path)).default_mass_kg  # type: ignore[arg-type]
-    except (ConfigError, TypeError):
+    except (ValueError, TypeError):  # sim.config.ConfigError is a ValueError
+        from sim.config import load_config
+
         fallback = load_config(None).default_mass_kg
         return fallback, "the paper stand's default weight (the stored stand is unreadable)"
     return mass, "stored in the recording"
@@ -81,6 +83,13 @@ def _mass_of(
 
 def run(args: argparse.Namespace) -> int:
     """Read, diagnose, report (or, with --campaigns, every campaign of a manifest)."""
+    from labstand.campaigns import trace_of, unique_names
+    from labstand.commands.diagnose_many import run_campaigns
+    from labstand.diagnosis_report import write_report
+    from recordings import RecordingError, open_recording
+    from sim.config import load_config
+    from sim.identify import DiagnosisInputError, diagnose
+
     if args.campaigns is not None:
         if args.recordings or args.report is not None or args.mass_kg is not None:
             raise CommandError(

@@ -9,10 +9,8 @@ import sys
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from drivers.signals import SignalSpec
-from labstand.campaign_table import campaign_row, write_results
 from labstand.commands.common import add_stand_options, load_stand
 from labstand.distributed import (
     ClusterOptions,
@@ -23,23 +21,18 @@ from labstand.distributed import (
     run_jobs,
 )
 from labstand.errors import CommandError, ExitCode
-from sim.config import StandConfig
-from sim.identify.check import (
-    CLASSES,
-    FULL_CAMPAIGN,
-    MASSES_KG,
-    SMALL_CAMPAIGN,
-    TRUTHS,
-    Case,
-    CaseSpec,
-    check_cases,
-    describe,
-    diagnose_case,
-    score,
-)
-from sim.identify.check_other import PairCase
-from sim.otherstand import OTHER_EFFECTS, OTHER_PAIRS
-from sim.otherstand.campaign import OTHER_FULL, OTHER_SMALL, OtherRecording
+
+if TYPE_CHECKING:  # imported where they run: `diagnose-check --help` loads no numba
+    from drivers.signals import SignalSpec
+    from sim.config import StandConfig
+    from sim.identify.check import Case, CaseSpec
+    from sim.identify.check_other import PairCase
+    from sim.otherstand.campaign import OtherRecording
+
+# Literal copies of sim.identify.check's TRUTHS and MASSES_KG, which imports numba: the
+# parser is built without it (tests/core/test_cli_startup.py checks that they agree).
+TRUTHS = ("same", "other")
+MASSES_KG = (3.096, 8.131)
 
 LABEL = "labstand diagnose-check"
 
@@ -48,7 +41,6 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Add ``labstand diagnose-check``."""
     parser = sub.add_parser(
         "diagnose-check",
-        help="score the diagnosis on generated recordings whose effect is withheld",
         description="For every effect and for 'none', at both weight masses, draw a real-like "
         "stand (±25 % mismatch), a random effect magnitude and realistic noise, simulate a "
         "quick, a medium and a slow recording, diagnose them blind, and score the answers.",
@@ -74,8 +66,6 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     parser.add_argument(
         "--effects",
         nargs="*",
-        choices=CLASSES,
-        default=CLASSES,
         metavar="NAME",
         help="classes to check (default: all nine effects and none; none given: no "
         "single-effect campaigns, only --pairs)",
@@ -116,6 +106,8 @@ class CheckSetup:
 
 def check_job(setup: CheckSetup, spec: CaseSpec) -> tuple[Case | PairCase, dict[str, Any]]:
     """The job: one blind campaign, scored; its diagnosis as JSON (runs on a worker)."""
+    from sim.identify.check import diagnose_case
+
     case, diagnosis = diagnose_case(
         setup.stand, spec, setup.campaign, setup.truth_stand, setup.other_campaign
     )
@@ -126,6 +118,8 @@ def run_cases(
     setup: CheckSetup, specs: Sequence[CaseSpec], options: ClusterOptions, progress: Progress
 ) -> list[JobResult[tuple[Case | PairCase, dict[str, Any]]]]:
     """Every campaign on the cluster (a single one here, unless a cluster was asked for)."""
+    from sim.identify.check import describe
+
     job = functools.partial(check_job, setup)
     keys = [s.name for s in specs]
 
@@ -140,8 +134,25 @@ def run_cases(
         return run_jobs(client, job, specs, keys, progress, threads, tell)
 
 
+def _classes(args: argparse.Namespace) -> list[str] | None:
+    """The classes asked for (None: all; CommandError, exit 2, for an unknown one)."""
+    from sim.identify.check import CLASSES
+
+    if args.effects is None:
+        return None
+    unknown = [name for name in args.effects if name not in CLASSES]
+    if unknown:
+        raise CommandError(
+            f"--effects: unknown class {unknown[0]!r} (known: {', '.join(CLASSES)})",
+            ExitCode.USAGE,
+        )
+    return list(args.effects)
+
+
 def _pairs(args: argparse.Namespace) -> list[tuple[str, str]]:
     """The two-effect campaigns asked for (CommandError, exit 2, if malformed)."""
+    from sim.otherstand import OTHER_EFFECTS, OTHER_PAIRS
+
     if args.pairs is None:
         return []
     if args.truth != "other":
@@ -163,7 +174,12 @@ def _pairs(args: argparse.Namespace) -> list[tuple[str, str]]:
 
 def run(args: argparse.Namespace) -> int:
     """Run the check and report."""
+    from labstand.campaign_table import campaign_row, write_results
+    from sim.identify.check import CLASSES, FULL_CAMPAIGN, SMALL_CAMPAIGN, check_cases, score
+    from sim.otherstand.campaign import OTHER_FULL, OTHER_SMALL
+
     stand = load_stand(args)
+    classes = _classes(args)
     pairs = _pairs(args)
     options = ClusterOptions.from_args(args)
     setup = CheckSetup(
@@ -172,7 +188,9 @@ def run(args: argparse.Namespace) -> int:
         args.truth,
         OTHER_SMALL if args.small else OTHER_FULL,
     )
-    specs = check_cases(args.seed, args.trials, args.effects, args.mass_kg, pairs)
+    specs = check_cases(
+        args.seed, args.trials, CLASSES if classes is None else classes, args.mass_kg, pairs
+    )
     progress = Progress(LABEL, len(specs), quiet=args.json)
     results = run_cases(setup, specs, options, progress)
     result = score(r.value[0] for r in results if r.value is not None)

@@ -31,7 +31,6 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Add ``labstand import``."""
     parser = sub.add_parser(
         "import",
-        help="import a CSV or TDMS run as a recording",
         description="Import a run exported from another tool (CSV) or recorded by the old "
         "LabVIEW stand (TDMS) into a recording (-o OUT.mcap or OUT.h5). Units are "
         "converted to the schema's (mm, N); a truncated TDMS file is trimmed to its "

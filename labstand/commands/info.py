@@ -7,9 +7,6 @@ import json
 from pathlib import Path
 from typing import Any
 
-from recordings import open_recording
-from recordings.convert import summary
-
 
 def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Add ``labstand info``."""
@@ -27,7 +24,10 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Read and summarise."""
-    info = summary(open_recording(args.recording))
+    from recordings import open_recording
+    from recordings.convert import summary
+
+    info = summary(open_recording(args.recording, log_repairs=False))
     if args.json:
         print(json.dumps(info, indent=2))
     else:

@@ -7,13 +7,13 @@ import json
 from typing import Any
 
 from labstand.commands.common import add_stand_options, load_stand
-from sim.effects import EFFECTS
-from sim.modes import linear_modes
 
 
 def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Add ``labstand model``."""
-    parser = sub.add_parser("model", help="properties of the baseline model")
+    parser = sub.add_parser(
+        "model", description="Properties of the baseline model: its modes, its effects."
+    )
     model_sub = parser.add_subparsers(dest="model_command", metavar="WHAT", required=True)
     modes = model_sub.add_parser(
         "modes",
@@ -38,6 +38,8 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
 
 def run_modes(args: argparse.Namespace) -> int:
     """Print the modes for one mass or for every configured weight."""
+    from sim.modes import linear_modes
+
     config = load_stand(args)
     masses = [args.mass_kg] if args.mass_kg is not None else sorted(config.weights_kg.values())
     rows: list[dict[str, Any]] = []
@@ -72,6 +74,8 @@ def run_modes(args: argparse.Namespace) -> int:
 
 def run_effects(args: argparse.Namespace) -> int:
     """List every effect with its parameters."""
+    from sim.effects import EFFECTS
+
     if args.json:
         print(json.dumps({"effects": [info.to_dict() for info in EFFECTS.values()]}, indent=2))
         return 0

@@ -6,15 +6,12 @@ import argparse
 from pathlib import Path
 
 from labstand.errors import CommandError, ExitCode
-from recordings import open_recording
-from recordings.convert import write_recording
 
 
 def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Add ``labstand recover``."""
     parser = sub.add_parser(
         "recover",
-        help="recover a recording whose writer was killed",
         description="Read BROKEN as far as it is intact (MCAP: every complete chunk, each "
         "CRC-checked; HDF5: the state of its last flush) and write a clean recording to "
         "-o FIXED (format by suffix). What was repaired is printed and stored as a "
@@ -27,9 +24,12 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Salvage and rewrite."""
+    from recordings import open_recording
+    from recordings.convert import write_recording
+
     if args.broken.resolve() == args.output.resolve():
         raise CommandError(f"{args.output}: would overwrite the damaged file", ExitCode.USAGE)
-    recording = open_recording(args.broken, salvage=True)
+    recording = open_recording(args.broken, salvage=True, log_repairs=False)
     write_recording(recording, args.output)
     print(
         f"Recovered {len(recording.gauges)} samples ({recording.duration_s:.3f} s, "

@@ -1,4 +1,4 @@
-"""``labstand replay``: a recording's drive motion through the model, compared per channel."""
+"""``labstand replay``: recordings' drive motion through the model, compared per channel."""
 
 from __future__ import annotations
 
@@ -7,15 +7,14 @@ import json
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from labstand.distributed import add_cluster_options, run_many
 from labstand.errors import CommandError, ExitCode
-from labstand.plots import plot_replay
-from labstand.recording_stand import mass_source, params_for
-from recordings import open_recording
-from recordings.replay import ReplayResult, replay
-from sim.metrics import ChannelMetrics
+
+if TYPE_CHECKING:  # imported where they run: `replay --help` loads no numba or pandas
+    from recordings.replay import ReplayResult
+    from sim.metrics import ChannelMetrics
 
 LABEL = "labstand replay"
 
@@ -24,9 +23,13 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Add ``labstand replay``."""
     parser = sub.add_parser(
         "replay",
-        help="feed a recording's drive motion into the model and compare",
-        description="Feed the recording's measured drive position into the baseline model "
-        "and compare simulated with recorded u, F and F − T0 (R, psi = (1 − R)^2, NRMSE).",
+        description="Feed each recording's measured drive position into the baseline model "
+        "and compare simulated with recorded u, F and F − T0 (R, psi = (1 − R)^2, NRMSE): "
+        "one result per recording. --json prints one object for one recording, a list of "
+        "them for several.",
+    )
+    parser.add_argument(
+        "recordings", type=Path, nargs="+", metavar="REC", help="recordings (.mcap .h5 .csv .tdms)"
     )
     parser.add_argument(
         "recordings",
@@ -45,7 +48,7 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
         "--stand",
         type=Path,
         metavar="FILE",
-        help="stand file (default: the one stored in the recording)",
+        help="stand file (default: the one stored in each recording)",
     )
     parser.add_argument(
         "--mass-kg",
@@ -70,6 +73,10 @@ class ReplayJob:
 
 
 def _replayed(job: ReplayJob) -> tuple[dict[str, Any], ReplayResult]:
+    from labstand.recording_stand import mass_source, params_for
+    from recordings import open_recording
+    from recordings.replay import replay
+
     recording = open_recording(job.recording)
     params, name = params_for(recording, job.stand, job.params, job.mass_kg)
     result = replay(recording.frame(), params)
@@ -116,6 +123,8 @@ def run(args: argparse.Namespace) -> int:
     out, result = _replayed(ReplayJob(args.recording, args.params, args.stand, args.mass_kg))
     name = out["params"]
     if args.plot is not None:
+        from labstand.plots import plot_replay
+
         plot_replay(
             args.plot,
             result,
@@ -138,8 +147,13 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def print_metrics(metrics: Mapping[str, ChannelMetrics]) -> None:
+def metric_lines(metrics: Mapping[str, ChannelMetrics]) -> list[str]:
     """A small table of R, psi and NRMSE per channel."""
-    print(f"  {'channel':8s} {'R':>10s} {'psi':>10s} {'NRMSE':>10s}")
-    for name, m in metrics.items():
-        print(f"  {name:8s} {m.R:10.6f} {m.psi:10.3g} {m.nrmse:10.4f}")
+    lines = [f"  {'channel':8s} {'R':>10s} {'psi':>10s} {'NRMSE':>10s}"]
+    lines += [f"  {n:8s} {m.R:10.6f} {m.psi:10.3g} {m.nrmse:10.4f}" for n, m in metrics.items()]
+    return lines
+
+
+def print_metrics(metrics: Mapping[str, ChannelMetrics]) -> None:
+    """Print ``metric_lines``."""
+    print("\n".join(metric_lines(metrics)))

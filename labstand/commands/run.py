@@ -37,24 +37,23 @@ from labstand.session import (
     Session,
     StopRequest,
 )
-from labstand.session.devices import BACKENDS, Devices, default_backend, open_devices
 from labstand.session.display import make_display
 from labstand.session.record import RecordingPipe
 from labstand.session.safety import EStopError, SafetyLimits
-from recordings.base import FORMATS, open_writer
+from recordings.base import open_writer
 from recordings.schema import Effect, RecordingMetadata, make_metadata
-from sim.config import StandConfig
-from sim.effects import EffectSpec, parse_effects
 
-if TYPE_CHECKING:
+if TYPE_CHECKING:  # imported where they run: `labstand run --help` loads no numba
     from labstand.live.view import LiveView
+    from labstand.session.devices import Devices
+    from sim.config import StandConfig
+    from sim.effects import EffectSpec
 
 
 def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Add ``labstand run``."""
     parser = sub.add_parser(
         "run",
-        help="run a test on the stand (or the simulated stand) and record it",
         description="Run a drive signal on the stand and record gauges (2 kHz), drive "
         "states and events to -o OUT (.mcap or .h5). --backend sim starts the simulated "
         "stand (same wire protocols) and is the default when the stand file has no "
@@ -64,9 +63,10 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     add_stand_options(parser)
     parser.add_argument(
         "--backend",
-        choices=BACKENDS,
+        metavar="NAME",
         help="stand: the devices of the stand file's [devices]; sim: the simulated stand "
-        "(default: stand if the stand file has [devices], else sim)",
+        "(default: stand if the stand file has [devices], else sim); any other backend of "
+        "the registry (labstand.session.devices.BACKENDS)",
     )
     parser.add_argument("-o", "--output", type=Path, required=True, help="recording (.mcap, .h5)")
     parser.add_argument("--note", default="", help="operator note, stored in the recording")
@@ -116,6 +116,9 @@ def _title(args: argparse.Namespace, spec: SignalSpec, mass_kg: float) -> str:
 
 
 def _effects(args: argparse.Namespace, backend: str) -> list[EffectSpec]:
+
+    from sim.effects import parse_effects
+
     effects = parse_effects(args.effect)
     if effects and backend != "sim":
         raise CommandError("--effect needs --backend sim", ExitCode.USAGE)
@@ -138,9 +141,18 @@ class _Plan:
 
 def _check(args: argparse.Namespace) -> _Plan:
     """Every check that needs no device: usage (2) and refusals (3)."""
+    from recordings.base import formats
+
     config = load_stand(args)
     spec, mass = signal_from_args(args, config)
+    from labstand.session.devices import BACKENDS, default_backend
+
     backend = args.backend or default_backend(config)
+    if backend not in BACKENDS:  # checked here, not by argparse: the registry pulls scipy
+        raise CommandError(
+            f"--backend: unknown backend {backend!r} (known: {', '.join(BACKENDS)})",
+            ExitCode.USAGE,
+        )
     if backend == "stand" and config.devices is None:
         raise CommandError(
             f"{config.source}: no [devices] table, so no stand to run; add one "
@@ -156,8 +168,9 @@ def _check(args: argparse.Namespace) -> _Plan:
     )
     plan_motion(spec, config.drive)  # LimitError: refused before anything is touched
     suffix = args.output.suffix.lower()
-    if suffix not in FORMATS or FORMATS[suffix][1] is None:
-        writable = sorted(s for s, f in FORMATS.items() if f[1] is not None)
+    known = formats()
+    if suffix not in known or known[suffix][1] is None:
+        writable = sorted(s for s, f in known.items() if f[1] is not None)
         raise CommandError(
             f"{args.output}: cannot record {suffix or 'without a suffix'!r}; use one of "
             f"{', '.join(writable)}",
@@ -195,6 +208,8 @@ def run(args: argparse.Namespace) -> int:
 
 def _run_devices(args: argparse.Namespace, plan: _Plan, live: LiveView | None) -> int:
     """Open the devices, run the session, report."""
+    from labstand.session.devices import open_devices
+
     devices = open_devices(
         plan.backend,
         plan.config,
@@ -232,6 +247,8 @@ def _session(
     live: LiveView | None,
 ) -> RunResult:
     """Pre-flight, summary, confirmation, prepare, then the recorded run."""
+    from labstand.session import StopRequest
+
     try:
         pre = session.preflight(plan.spec, args.reset_trip)
     except PreflightError as err:
@@ -346,6 +363,7 @@ def _stop_signals(stop: StopRequest) -> Iterator[None]:
 
 
 def _report(result: RunResult, output: Path, sim: dict[str, Any]) -> int:
+
     stats = result.stats
     where = (
         f"recording {output} closed ({result.elapsed_s:.2f} s, {result.samples} samples, "

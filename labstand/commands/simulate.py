@@ -7,21 +7,23 @@ import json
 import time
 from dataclasses import replace
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from numpy.typing import NDArray
 
+# Light (numpy only): the parser's choices. The model (numba, scipy) is imported in run().
 from drivers.signals import DriveProfile, Shape, SignalSpec, plan_motion
 from labstand.commands.common import add_stand_options, load_stand
 from labstand.errors import CommandError, ExitCode
-from labstand.output import write_simulation
-from sim.config import StandConfig
-from sim.effects import EffectSpec, parse_effects
-from sim.effects.realism import NoiseSpec, add_measurement_noise
-from sim.model import Model, SimResult
-from sim.params import StandParams
 from sim.situations import SITUATIONS, situation
+
+if TYPE_CHECKING:
+    from numpy.typing import NDArray
+
+    from sim.config import StandConfig
+    from sim.effects import EffectSpec
+    from sim.params import StandParams
+    from sim.results import SimResult
 
 
 def add_signal_options(parser: argparse.ArgumentParser) -> None:
@@ -77,7 +79,6 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Add ``labstand simulate``."""
     parser = sub.add_parser(
         "simulate",
-        help="simulate a run with the baseline model",
         description="Simulate the stand for a paper situation (--situation) or any drive "
         "signal (--signal ...). Writes the run to -o OUT (format by suffix).",
     )
@@ -120,6 +121,10 @@ def summarise(result: SimResult, profile: DriveProfile, mass_kg: float) -> dict[
 
 def run(args: argparse.Namespace) -> int:
     """Simulate, write, summarise."""
+    from labstand.output import write_simulation
+    from sim.effects import parse_effects
+    from sim.model import Model
+
     config = load_stand(args)
     spec, mass = signal_from_args(args, config)
     profile = plan_motion(spec, config.drive)
@@ -165,6 +170,9 @@ def _simulate_real_like(
 
     Returns the recorded-like run and the true one (for the summary's slack figures).
     """
+    from sim.effects.realism import NoiseSpec, add_measurement_noise
+    from sim.model import Model
+
     run = Model(params, effects).run(x_m, rate_hz)
     truth = replace(run, u_m=run.true_u_m, force_n=run.true_force_n)
     result: SimResult = run

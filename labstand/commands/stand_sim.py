@@ -20,12 +20,12 @@ import json
 import os
 import signal
 import sys
-from typing import TextIO
+from typing import TYPE_CHECKING, TextIO
 
 from labstand.commands.common import add_stand_options, load_stand
-from sim.hardware.faults import parse_fault
-from sim.hardware.gauges import FrontEndSettings
-from sim.hardware.stand import ScaledClock, SimulatedStand, StandSettings
+
+if TYPE_CHECKING:  # pymodbus, numba: imported when the stand starts, not for --help
+    from sim.hardware.stand import SimulatedStand
 
 PARENT_POLL_S = 0.2
 #: After its parent died, how long an enabled simulated drive may take to stop (its
@@ -39,7 +39,6 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Add ``labstand stand-sim``."""
     parser = sub.add_parser(
         "stand-sim",
-        help="run the simulated stand (Modbus drive + 2 kHz gauges) on its own",
         description="Serve the simulated Unidrive SP over Modbus (TCP on 127.0.0.1, or RTU on "
         "a pseudo-terminal) and the simulated gauge front end on a pseudo-terminal, both "
         "driven by the stand model. Prints where to connect; stops on Ctrl-C or SIGTERM.",
@@ -153,6 +152,10 @@ async def _serve(stand: SimulatedStand, args: argparse.Namespace) -> None:
 
 def run_stand_sim(args: argparse.Namespace) -> int:
     """Serve until stopped."""
+    from sim.hardware.faults import parse_fault
+    from sim.hardware.gauges import FrontEndSettings
+    from sim.hardware.stand import ScaledClock, SimulatedStand, StandSettings
+
     config = load_stand(args)
     settings = StandSettings(
         modbus=args.modbus,

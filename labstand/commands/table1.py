@@ -9,9 +9,6 @@ from pathlib import Path
 from typing import Any
 
 from labstand.distributed import add_cluster_options, run_many
-from labstand.recording_stand import mass_source, params_for
-from recordings import open_recording
-from recordings.replay import replay
 
 LABEL = "labstand table1"
 
@@ -20,7 +17,6 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Add ``labstand table1``."""
     parser = sub.add_parser(
         "table1",
-        help="Table 1 of the paper: R per channel for two parameter sets",
         description="For each recording, R of the weight displacement and of the dynamic "
         "force for two parameter sets side by side (the paper's Table 1), plus NRMSE. "
         "Several recordings are replayed in parallel on Dask.",
@@ -53,6 +49,10 @@ class Table1Job:
 
 def table1_row(job: Table1Job) -> dict[str, Any]:
     """The job: replay one recording with both sets (runs on a worker)."""
+    from labstand.recording_stand import mass_source, params_for
+    from recordings import open_recording
+    from recordings.replay import replay
+
     recording = open_recording(job.recording)
     row: dict[str, Any] = {"recording": str(job.recording)}
     signal = recording.metadata.signal or {}
@@ -97,7 +97,7 @@ def run(args: argparse.Namespace) -> int:
         print(
             f"| {Path(r['recording']).name} | {r['signal']} | {freq} | {r['mass_kg']:g} | "
             f"{f['R_u']:.6f} | "
-            f"{s['R_u']:.6f} | {f['R_F_dyn']:.5f} | {s['R_F_dyn']:.5f} | {s['nrmse_u']:.4f} | "
+            f"{s['R_u']:.6f} | {f['R_F_dyn']:.6f} | {s['R_F_dyn']:.6f} | {s['nrmse_u']:.4f} | "
             f"{s['nrmse_F']:.4f} |"
         )
     sources = sorted({r["mass_source"] for r in rows})

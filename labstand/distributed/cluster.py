@@ -15,10 +15,12 @@ import os
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
-
-from distributed import Client, LocalCluster
+from typing import TYPE_CHECKING
 
 from labstand.errors import CommandError, ExitCode
+
+if TYPE_CHECKING:  # dask is imported where it runs: a command's --help stays quick
+    from distributed import Client
 
 #: The address of an existing scheduler when ``--scheduler`` is not given (as Dask's own).
 SCHEDULER_ENV = "DASK_SCHEDULER_ADDRESS"
@@ -96,6 +98,8 @@ def open_client(
     The thread count is None on an existing cluster: its workers were started with their
     own ``NUMBA_NUM_THREADS`` (see docs/scale-out.md).
     """
+    from distributed import Client, LocalCluster
+
     if options.scheduler is not None:
         try:
             client = Client(options.scheduler, timeout=CONNECT_TIMEOUT)

@@ -17,11 +17,12 @@ import time
 import uuid
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Any, Generic, TypeVar
-
-from distributed import Client, as_completed, get_worker
+from typing import TYPE_CHECKING, Any, Generic, TypeVar
 
 from labstand.distributed.progress import Progress
+
+if TYPE_CHECKING:  # dask is imported where it runs: a command's --help stays quick
+    from distributed import Client
 
 T = TypeVar("T")
 R = TypeVar("R")
@@ -49,6 +50,8 @@ class JobResult(Generic[R]):
 
 
 def _where() -> str:
+    from distributed import get_worker
+
     try:
         return str(get_worker().address)
     except ValueError:  # not on a worker
@@ -102,6 +105,8 @@ def run_jobs(
         finally:
             progress.close()
         return [results[i] for i in range(len(items))]
+    from distributed import as_completed
+
     run_id = uuid.uuid4().hex[:8]
     futures = [
         client.submit(call_job, fn, item, threads, key=f"labstand-{run_id}-{i}", pure=False)

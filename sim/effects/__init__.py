@@ -13,16 +13,55 @@ Exceptions::
           └── EffectError       unknown effect or parameter, value out of range
 """
 
-from sim.effects.realism import MeasurementNoise, NoiseSpec, add_measurement_noise, draw_real_stand
-from sim.effects.registry import (
-    EFFECTS,
-    EffectError,
-    EffectInfo,
-    EffectSpec,
-    ParamInfo,
-    parse_effect,
-    parse_effects,
-)
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
+
+# Lazy re-exports (PEP 562): importing one module of the package (``sim.effects.errors``,
+# say) must not load the heavy ones (numba, scipy, pandas, h5py, ...) through it.
+# A name here must not name both an object and a submodule (importing the submodule
+# would rebind it to the module): sim.identify, whose ``diagnose`` is both, stays eager.
+_EXPORTS = {
+    "MeasurementNoise": "sim.effects.realism",
+    "NoiseSpec": "sim.effects.realism",
+    "add_measurement_noise": "sim.effects.realism",
+    "draw_real_stand": "sim.effects.realism",
+    "EFFECTS": "sim.effects.registry",
+    "EffectError": "sim.effects.registry",
+    "EffectInfo": "sim.effects.registry",
+    "EffectSpec": "sim.effects.registry",
+    "ParamInfo": "sim.effects.registry",
+    "parse_effect": "sim.effects.registry",
+    "parse_effects": "sim.effects.registry",
+}
+
+if TYPE_CHECKING:
+    from sim.effects.realism import (
+        MeasurementNoise,
+        NoiseSpec,
+        add_measurement_noise,
+        draw_real_stand,
+    )
+    from sim.effects.registry import (
+        EFFECTS,
+        EffectError,
+        EffectInfo,
+        EffectSpec,
+        ParamInfo,
+        parse_effect,
+        parse_effects,
+    )
+
+
+def __getattr__(name: str) -> Any:
+    module = _EXPORTS.get(name)
+    if module is None:
+        raise AttributeError(f"module 'sim.effects' has no attribute {name!r}")
+    if module == f"{__name__}.{name}":  # a submodule
+        return importlib.import_module(module)
+    return getattr(importlib.import_module(module), name)
+
 
 __all__ = [
     "EFFECTS",

@@ -9,8 +9,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from labstand.campaigns import trace_of
 from labstand.cli import main
-from labstand.commands.diagnose import trace_of
 from sim.config import StandConfig
 from sim.identify import DiagnosisInputError, diagnose
 from sim.identify.check import SMALL_CAMPAIGN, make_campaign, run_check
