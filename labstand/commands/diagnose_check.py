@@ -5,7 +5,6 @@ from __future__ import annotations
 import argparse
 import functools
 import json
-import sys
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -19,6 +18,7 @@ from labstand.distributed import (
     add_cluster_options,
     open_client,
     run_jobs,
+    say_failures,
 )
 from labstand.errors import CommandError, ExitCode
 
@@ -215,14 +215,7 @@ def run(args: argparse.Namespace) -> int:
         files = write_results(args.results, rows, CLASSES)
         progress.say(f"wrote {', '.join(str(f) for f in files)}")
     code = _report(args, out)
-    if failed:
-        print(
-            f"{LABEL}: {len(failed)} of {len(results)} campaign(s) failed: "
-            + "; ".join(f"{r.key}: {r.error}" for r in failed),
-            file=sys.stderr,
-        )
-        return ExitCode.FAILURE
-    return code
+    return ExitCode.FAILURE if say_failures(LABEL, results) else code
 
 
 def _report(args: argparse.Namespace, out: dict[str, Any]) -> int:

@@ -5,13 +5,19 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import json
-import sys
 from pathlib import Path
 from typing import Any
 
 from labstand.campaign_table import campaign_row, write_results
 from labstand.campaigns import Campaign, diagnose_campaign, load_manifest
-from labstand.distributed import ClusterOptions, JobResult, Progress, open_client, run_jobs
+from labstand.distributed import (
+    ClusterOptions,
+    JobResult,
+    Progress,
+    open_client,
+    run_jobs,
+    say_failures,
+)
 from labstand.errors import ExitCode
 
 LABEL = "labstand diagnose"
@@ -56,15 +62,7 @@ def run_campaigns(args: argparse.Namespace) -> int:
         print(json.dumps(out, indent=2))
     else:
         _print_table(rows)
-    failed = [r for r in results if not r.ok]
-    if failed:
-        print(
-            f"{LABEL}: {len(failed)} of {len(results)} campaign(s) failed: "
-            + "; ".join(f"{r.key}: {r.error}" for r in failed),
-            file=sys.stderr,
-        )
-        return ExitCode.FAILURE
-    return ExitCode.OK
+    return ExitCode.FAILURE if say_failures(LABEL, results) else ExitCode.OK
 
 
 def _result(campaign: Campaign, r: JobResult[dict[str, Any]]) -> dict[str, Any]:

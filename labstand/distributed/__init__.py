@@ -15,7 +15,7 @@ The one way labstand runs many campaigns or recordings at once (``diagnose-check
 """
 
 from labstand.distributed.cluster import ClusterOptions, add_cluster_options, open_client
-from labstand.distributed.jobs import JobResult, run_jobs
+from labstand.distributed.jobs import JobResult, run_jobs, say_failures
 from labstand.distributed.many import run_many
 from labstand.distributed.progress import Progress
 
@@ -27,4 +27,5 @@ __all__ = [
     "open_client",
     "run_jobs",
     "run_many",
+    "say_failures",
 ]

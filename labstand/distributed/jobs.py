@@ -13,6 +13,7 @@ Faults, and what each costs:
 
 from __future__ import annotations
 
+import sys
 import time
 import uuid
 from collections.abc import Callable, Sequence
@@ -127,3 +128,15 @@ def run_jobs(
         client.cancel([f for f in futures if not f.done()])
         progress.close()
     return [results[i] for i in range(len(items))]
+
+
+def say_failures(label: str, results: Sequence[JobResult[Any]]) -> bool:
+    """One line on stderr naming every failed job and its error; whether any failed."""
+    failed = [r for r in results if not r.ok]
+    if failed:
+        print(
+            f"{label}: {len(failed)} of {len(results)} campaign(s) failed: "
+            + "; ".join(f"{r.key}: {r.error}" for r in failed),
+            file=sys.stderr,
+        )
+    return bool(failed)

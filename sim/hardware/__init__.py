@@ -62,6 +62,8 @@ if TYPE_CHECKING:
     from sim.hardware.stand_model import available_effects, build_stand_model
 
 
+# The same PEP 562 hook in every package __init__ (drivers, sim, sim.effects, sim.hardware,
+# recordings): a shared helper would have to live in the lowest layer, drivers.
 def __getattr__(name: str) -> Any:
     module = _EXPORTS.get(name)
     if module is None:

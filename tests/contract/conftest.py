@@ -20,8 +20,6 @@ tests skip there.
 from __future__ import annotations
 
 import os
-import shutil
-import subprocess
 import time
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
@@ -35,6 +33,7 @@ from drivers.unidrive import open_unidrive
 from sim.config import StandConfig, default_config, load_config
 from sim.hardware.stand import ScaledClock, SimulatedStand, StandSettings, StandThread
 from tests.hardware_sim.leakcheck import no_leaks
+from tests.ptys import socat_ptys
 
 __all__ = ["DriveRig", "GaugeRig", "no_leaks"]
 
@@ -117,27 +116,8 @@ def _set_muted(thread: StandThread, on: bool) -> None:
 
 @pytest.fixture(scope="module")
 def _socat_pair(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[str, str]]:
-    if shutil.which("socat") is None:
-        pytest.fail("socat is not installed (make system-tools installs it)")
-    folder = tmp_path_factory.mktemp("rtu")
-    a, b = folder / "server", folder / "client"
-    proc = subprocess.Popen(
-        ["socat", f"pty,raw,echo=0,link={a}", f"pty,raw,echo=0,link={b}"],
-        stdout=subprocess.DEVNULL,
-        stderr=subprocess.DEVNULL,
-    )
-    deadline = time.monotonic() + 5.0
-    while not (a.exists() and b.exists()):
-        if time.monotonic() > deadline or proc.poll() is not None:
-            proc.kill()
-            proc.wait()
-            pytest.fail("socat did not create its pty pair")
-        time.sleep(0.01)
-    try:
-        yield str(a), str(b)
-    finally:
-        proc.terminate()
-        proc.wait(5)
+    with socat_ptys(tmp_path_factory.mktemp("rtu")) as pair:
+        yield pair
 
 
 @pytest.fixture(scope="module", params=["sim-tcp", "sim-rtu", _HARDWARE])
