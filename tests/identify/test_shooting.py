@@ -276,3 +276,27 @@ def test_the_pulley_seat_follows_the_recorded_slack_so_restarts_keep_the_right_g
         errors.append(heldout_error([tr], [Outputs(u[0], f[0])]))
     assert segment_trace(tr).count > 3
     assert errors[0] < 1.2 * errors[1]
+
+
+def test_a_threshold_is_found_by_scanning_and_held_in_the_local_fit(stand: StandConfig) -> None:
+    # A seat that flips once the fibre has lain slack 30 ms: the output error is flat
+    # between the recorded episodes' lengths, so a gradient cannot find the dwell; the
+    # local fit leaves it where it started, the scan finds it.
+    from sim.identify.fitting import fit, scan_thresholds
+
+    effect = "fibre_pulley_jump"
+    truth = {"step_m": 5e-4, "depth_scale_m": 1e-5, "dwell_s": 0.03}
+    tr, _ = _trace(stand, 8.131, [EffectSpec(effect, truth)])
+    nominal = stand.stand_params("final", 8.131)
+    candidate = Candidate.build(effect)
+    start = dict(BASE, **{f"{effect}.{k}": v for k, v in truth.items()})
+    start[f"{effect}.onset_m"] = 0.0
+    start[f"{effect}.dwell_s"] = 0.1  # longer than every episode: the seat never moves
+    local = fit(candidate, [tr], nominal, baseline=start, single_start=True, max_nfev=5)
+    assert local.values[f"{effect}.dwell_s"] == pytest.approx(0.1, rel=1e-9)
+    scanned, cost, sims = scan_thresholds(candidate, [tr], nominal, start)
+    assert sims > 20
+    assert cost < 0.1 * local.train_cost
+    # Any dwell between the longest episode shorter than 30 ms and the shortest longer
+    # one explains the recording alike; the scan lands in that gap.
+    assert 0.015 < scanned[f"{effect}.dwell_s"] < 0.045
