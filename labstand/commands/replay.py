@@ -29,13 +29,10 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
         "them for several.",
     )
     parser.add_argument(
-        "recordings", type=Path, nargs="+", metavar="REC", help="recordings (.mcap .h5 .csv .tdms)"
-    )
-    parser.add_argument(
         "recordings",
         type=Path,
         nargs="+",
-        metavar="recording",
+        metavar="REC",
         help="recording(s) (.mcap, .h5, .csv, .tdms); several are replayed in parallel on Dask",
     )
     parser.add_argument(

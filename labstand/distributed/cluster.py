@@ -100,6 +100,10 @@ def open_client(
     """
     from distributed import Client, LocalCluster
 
+    # Dask configures its loggers at INFO on import: its connection chatter would bury the
+    # progress line; -v (labstand's DEBUG) keeps it.
+    if not logging.getLogger("labstand").isEnabledFor(logging.DEBUG):
+        logging.getLogger("distributed").setLevel(logging.WARNING)
     if options.scheduler is not None:
         try:
             client = Client(options.scheduler, timeout=CONNECT_TIMEOUT)
