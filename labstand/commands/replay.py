@@ -4,16 +4,14 @@ from __future__ import annotations
 
 import argparse
 import json
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from labstand.distributed import add_cluster_options, run_many
-from labstand.errors import CommandError, ExitCode
 
 if TYPE_CHECKING:  # imported where they run: `replay --help` loads no numba or pandas
-    from recordings.replay import ReplayResult
     from sim.metrics import ChannelMetrics
 
 LABEL = "labstand replay"
@@ -54,22 +52,30 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
         "stored in the recording)",
     )
     parser.add_argument("--json", action="store_true", help="print JSON (channels.u.R, ...)")
-    parser.add_argument("--plot", type=Path, metavar="PNG", help="recorded vs simulated + residual")
+    parser.add_argument(
+        "--plot",
+        type=Path,
+        metavar="PNG",
+        help="recorded vs simulated + residual; with several recordings one file each, "
+        "named PNG's name + '-' + the recording's stem (--plot out/r.png: out/r-s11.png, ...)",
+    )
     add_cluster_options(parser)
     parser.set_defaults(func=run)
 
 
 @dataclass(frozen=True)
 class ReplayJob:
-    """One recording to replay."""
+    """One recording to replay (and where its plot goes, if anywhere)."""
 
     recording: Path
     params: str
     stand: Path | None
     mass_kg: float | None
+    plot: Path | None = None
 
 
-def _replayed(job: ReplayJob) -> tuple[dict[str, Any], ReplayResult]:
+def replay_one(job: ReplayJob) -> dict[str, Any]:
+    """The job: a recording's replay as JSON, its plot written (runs on a worker for many)."""
     from labstand.recording_stand import mass_source, params_for
     from recordings import open_recording
     from recordings.replay import replay
@@ -84,22 +90,35 @@ def _replayed(job: ReplayJob) -> tuple[dict[str, Any], ReplayResult]:
         "mass_source": mass_source(recording, job.stand, job.mass_kg),
         **result.to_dict(),
     }
-    return out, result
+    if job.plot is not None:
+        from labstand.plots import plot_replay
+
+        title = f"{job.recording.name}: replay with '{name}'"
+        plot_replay(job.plot, result, title, second_label="simulated")
+        out["plot"] = str(job.plot)
+    return out
 
 
-def replay_one(job: ReplayJob) -> dict[str, Any]:
-    """The job: a recording's replay as JSON (runs on a worker for several recordings)."""
-    return _replayed(job)[0]
+def plot_paths(plot: Path, recordings: Sequence[Path]) -> list[Path]:
+    """Where each recording's plot goes: ``plot`` itself for one, else one per stem."""
+    if len(recordings) == 1:
+        return [plot]
+    stems = [r.stem for r in recordings]
+    # two recordings of one stem (a/s11.mcap, b/s11.mcap) are told apart by their position
+    tags = [s if stems.count(s) == 1 else f"{s}-{i + 1}" for i, s in enumerate(stems)]
+    return [plot.with_name(f"{plot.stem}-{tag}{plot.suffix}") for tag in tags]
 
 
-def run_several(args: argparse.Namespace) -> int:
-    """Replay several recordings (JSON: a list, one object per recording)."""
-    if args.plot is not None:
-        raise CommandError("--plot takes one recording", ExitCode.USAGE)
-    jobs = [ReplayJob(p, args.params, args.stand, args.mass_kg) for p in args.recordings]
+def run(args: argparse.Namespace) -> int:
+    """Replay each recording (several in parallel on Dask) and report."""
+    plots = plot_paths(args.plot, args.recordings) if args.plot is not None else None
+    jobs = [
+        ReplayJob(p, args.params, args.stand, args.mass_kg, plots[i] if plots else None)
+        for i, p in enumerate(args.recordings)
+    ]
     outs, code = run_many(args, replay_one, jobs, [str(p) for p in args.recordings], LABEL)
     if args.json:
-        print(json.dumps(outs, indent=2))
+        print(json.dumps(outs[0] if len(jobs) == 1 and outs else outs, indent=2))
         return code
     for out in outs:
         print(f"Replay of {out['recording']} with parameters '{out['params']}', "
@@ -109,39 +128,9 @@ def run_several(args: argparse.Namespace) -> int:
             print(f"  {name:8s} {m['R']:10.6f} {m['psi']:10.3g} {m['nrmse']:10.4f}")
         for note in out["notes"]:
             print(f"  note: {note}")
+        if "plot" in out:
+            print(f"  wrote {out['plot']}")
     return code
-
-
-def run(args: argparse.Namespace) -> int:
-    """Replay and report."""
-    if len(args.recordings) > 1 or args.scheduler is not None or args.workers is not None:
-        return run_several(args)
-    args.recording = args.recordings[0]
-    out, result = _replayed(ReplayJob(args.recording, args.params, args.stand, args.mass_kg))
-    name = out["params"]
-    if args.plot is not None:
-        from labstand.plots import plot_replay
-
-        plot_replay(
-            args.plot,
-            result,
-            f"{args.recording.name}: replay with '{name}'",
-            second_label="simulated",
-        )
-        out["plot"] = str(args.plot)
-    if args.json:
-        print(json.dumps(out, indent=2))
-        return 0
-    print(
-        f"Replay of {args.recording} with parameters '{name}', "
-        f"m = {out['mass_kg']:g} kg ({out['mass_source']}):"
-    )
-    print_metrics(result.metrics)
-    for note in result.notes:
-        print(f"  note: {note}")
-    if args.plot is not None:
-        print(f"  wrote {args.plot}")
-    return 0
 
 
 def metric_lines(metrics: Mapping[str, ChannelMetrics]) -> list[str]:

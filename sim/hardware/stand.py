@@ -293,7 +293,9 @@ class StandThread:
     access to the simulated drive).
     """
 
-    def __init__(self, stand: SimulatedStand, start_timeout_s: float = 10.0) -> None:
+    # Ready means compiled: a fresh clone's first compile of the stand's model takes tens of
+    # seconds on a loaded machine (StandProcess allows as long).
+    def __init__(self, stand: SimulatedStand, start_timeout_s: float = 120.0) -> None:
         self.stand = stand
         self._timeout = start_timeout_s
         self._thread = threading.Thread(target=self._run, name="simulated-stand", daemon=True)
