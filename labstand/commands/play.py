@@ -10,7 +10,15 @@ are imported inside ``run``.
 from __future__ import annotations
 
 import argparse
+import signal
+import threading
 from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from labstand.live.address import ViewerAddress
+    from recordings import Recording
+    from sim.params import StandParams
 
 
 def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -54,12 +62,8 @@ SETTLE_S = 0.3
 
 def run(args: argparse.Namespace) -> int:
     """Serve the recording until it ends (or Ctrl-C with --loop)."""
-    import time
-
     from labstand.errors import CommandError, ExitCode
     from labstand.live.address import parse_address
-    from labstand.live.player import Player, WallClock
-    from labstand.live.server import LiveServer
     from labstand.recording_stand import params_for
     from recordings import open_recording
 
@@ -74,6 +78,36 @@ def run(args: argparse.Namespace) -> int:
             f"(0 … {recording.duration_s:.3f} s)",
             ExitCode.USAGE,
         )
+    # Ctrl-C is remembered as well as raised: a KeyboardInterrupt raised inside the
+    # server's native code can be lost there (seen: a --loop that never ended).
+    interrupted = threading.Event()
+
+    def on_interrupt(signum: int, frame: object) -> None:
+        interrupted.set()
+        raise KeyboardInterrupt
+
+    previous = signal.signal(signal.SIGINT, on_interrupt)
+    try:
+        return _serve(args, address, recording, params, name, interrupted)
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+def _serve(
+    args: argparse.Namespace,
+    address: ViewerAddress,
+    recording: Recording,
+    params: StandParams,
+    name: str,
+    interrupted: threading.Event,
+) -> int:
+    """Play once (or loop) to the clients of a server at ``address``."""
+    import time
+
+    from labstand.errors import ExitCode
+    from labstand.live.player import Player, WallClock
+    from labstand.live.server import LiveServer
+
     with LiveServer(address, f"labstand play {args.recording.name}") as server:
         player = Player(recording, server, params, WallClock(), args.speed, args.start)
         print(
@@ -94,7 +128,9 @@ def run(args: argparse.Namespace) -> int:
             start_ns = max(time.time_ns(), end_ns + 1_000_000)
             server.epoch_ns = start_ns - player.start_ns
             end_ns = start_ns + player.span_ns
-            stats = player.play()
+            stats = player.play(stop=interrupted.is_set)
+            if interrupted.is_set():
+                raise KeyboardInterrupt
             passes += 1
             print(
                 f"  pass {passes}: {stats.samples} samples, {stats.drive} drive polls, "

@@ -13,7 +13,9 @@ Faults, and what each costs:
 
 from __future__ import annotations
 
+import signal
 import sys
+import threading
 import time
 import uuid
 from collections.abc import Callable, Sequence
@@ -114,8 +116,21 @@ def run_jobs(
         for i, item in enumerate(items)
     ]
     index = {f.key: i for i, f in enumerate(futures)}
+    # Ctrl-C is remembered as well as raised: a KeyboardInterrupt raised inside Dask's
+    # own waiting can be swallowed there (seen: a run finished every job after Ctrl-C).
+    interrupted = threading.Event()
+    previous = None
+    if threading.current_thread() is threading.main_thread():
+
+        def on_interrupt(signum: int, frame: object) -> None:
+            interrupted.set()
+            raise KeyboardInterrupt
+
+        previous = signal.signal(signal.SIGINT, on_interrupt)
     try:
         for future in as_completed(futures):
+            if interrupted.is_set():
+                raise KeyboardInterrupt
             i = index[future.key]
             try:
                 out: tuple[Any, str | None, str | None, float, str, bool] = future.result()
@@ -124,7 +139,11 @@ def run_jobs(
                 results[i] = JobResult(keys[i], None, f"{type(err).__name__}: {err}",
                                        type(err).__name__, 0.0, "")  # fmt: skip
             progress.advance(tell(results[i]))
+        if interrupted.is_set():
+            raise KeyboardInterrupt
     finally:
+        if previous is not None:
+            signal.signal(signal.SIGINT, previous)
         client.cancel([f for f in futures if not f.done()])
         progress.close()
     return [results[i] for i in range(len(items))]
