@@ -375,7 +375,10 @@ def _after_part(c, y, x, xd, h):  # type: ignore[no-untyped-def]
         c[S_PZ] = min(max(c[S_PZ] + y[Y_S] - c[S_PS0], -zmax), zmax)
         c[S_PS0] = y[Y_S]
     if c[R_PJ_ON] > 0.0:
-        _reseat(c, c[S_TAUT2] <= 0.0, c[P_PRELOAD] + x - c[P_PROJ] * y[Y_U], h)
+        # The weight-side segment carries the seat (one segment: S_TAUT2 is only
+        # refreshed at a step's start; S_TAUT1 follows every located switch).
+        taut = c[S_TAUT2] if c[D_NSEG] > 1.5 else c[S_TAUT1]
+        _reseat(c, taut <= 0.0, c[P_PRELOAD] + x - c[P_PROJ] * y[Y_U], h)
 
 
 @njit(cache=True, error_model="numpy")
