@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import shutil
+import signal
 import subprocess
 import time
 from collections.abc import Iterator
@@ -35,3 +36,19 @@ def socat_ptys(folder: Path) -> Iterator[tuple[str, str]]:
     finally:
         proc.terminate()
         proc.wait(5)
+
+
+@contextmanager
+def sigint_not_ignored() -> Iterator[None]:
+    """Around starting a child that a test interrupts with SIGINT (Ctrl-C).
+
+    A child inherits an ignored SIGINT, and Python then never raises KeyboardInterrupt:
+    under the whole suite (but in no module alone) an interrupted child ran on to its
+    end. While this is open, SIGINT in this process is caught (not ignored), so a child
+    started here gets it at its default, as from a terminal.
+    """
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)

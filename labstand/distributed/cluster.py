@@ -12,6 +12,8 @@ import argparse
 import importlib.util
 import logging
 import os
+import signal
+import threading
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -124,6 +126,7 @@ def open_client(
     n = options.workers or cores
     threads = options.numba_threads or numba_threads(n, cores)
     with (
+        remembered_interrupt() as interrupted,
         LocalCluster(
             n_workers=n,
             threads_per_worker=1,
@@ -138,11 +141,15 @@ def open_client(
         ) as cluster,
         Client(cluster) as client,
     ):
+        if interrupted.is_set():  # Ctrl-C while the workers started
+            raise KeyboardInterrupt
         say(
             f"local cluster: {n} worker process(es) × 1 thread, numba {threads} thread(s) "
             f"each; {_dashboard(client)}"
         )
         yield client, threads
+        if interrupted.is_set():  # a Ctrl-C that Dask's waiting swallowed
+            raise KeyboardInterrupt
 
 
 def _dashboard(client: Client) -> str:
@@ -150,3 +157,27 @@ def _dashboard(client: Client) -> str:
         return "dashboard off (bokeh is not installed)"
     link = client.dashboard_link
     return f"dashboard {link}" if link else "no dashboard"
+
+
+@contextmanager
+def remembered_interrupt() -> Iterator[threading.Event]:
+    """Ctrl-C remembered as well as raised, for the ``with`` block (main thread only).
+
+    A KeyboardInterrupt raised inside Dask's own waiting (starting workers, waiting for
+    results) can be lost there: a run went on to finish every job after Ctrl-C. The
+    event lets the caller raise it again where it looks.
+    """
+    event = threading.Event()
+    if threading.current_thread() is not threading.main_thread():
+        yield event
+        return
+
+    def on_interrupt(signum: int, frame: object) -> None:
+        event.set()
+        raise KeyboardInterrupt
+
+    previous = signal.signal(signal.SIGINT, on_interrupt)
+    try:
+        yield event
+    finally:
+        signal.signal(signal.SIGINT, previous)

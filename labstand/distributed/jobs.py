@@ -13,7 +13,6 @@ Faults, and what each costs:
 
 from __future__ import annotations
 
-import signal
 import sys
 import threading
 import time
@@ -22,6 +21,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Generic, TypeVar
 
+from labstand.distributed.cluster import remembered_interrupt
 from labstand.distributed.progress import Progress
 
 if TYPE_CHECKING:  # dask is imported where it runs: a command's --help stays quick
@@ -108,25 +108,28 @@ def run_jobs(
         finally:
             progress.close()
         return [results[i] for i in range(len(items))]
-    from distributed import as_completed
-
     run_id = uuid.uuid4().hex[:8]
     futures = [
         client.submit(call_job, fn, item, threads, key=f"labstand-{run_id}-{i}", pure=False)
         for i, item in enumerate(items)
     ]
+    with remembered_interrupt() as interrupted:
+        return _gather(client, futures, keys, progress, tell, interrupted)
+
+
+def _gather(
+    client: Client,
+    futures: list[Any],
+    keys: Sequence[str],
+    progress: Progress,
+    tell: Callable[[JobResult[R]], str],
+    interrupted: threading.Event,
+) -> list[JobResult[R]]:
+    """The jobs' results as they finish, in the items' order; Ctrl-C cancels the rest."""
+    from distributed import as_completed
+
     index = {f.key: i for i, f in enumerate(futures)}
-    # Ctrl-C is remembered as well as raised: a KeyboardInterrupt raised inside Dask's
-    # own waiting can be swallowed there (seen: a run finished every job after Ctrl-C).
-    interrupted = threading.Event()
-    previous = None
-    if threading.current_thread() is threading.main_thread():
-
-        def on_interrupt(signum: int, frame: object) -> None:
-            interrupted.set()
-            raise KeyboardInterrupt
-
-        previous = signal.signal(signal.SIGINT, on_interrupt)
+    results: dict[int, JobResult[R]] = {}
     try:
         for future in as_completed(futures):
             if interrupted.is_set():
@@ -142,11 +145,9 @@ def run_jobs(
         if interrupted.is_set():
             raise KeyboardInterrupt
     finally:
-        if previous is not None:
-            signal.signal(signal.SIGINT, previous)
         client.cancel([f for f in futures if not f.done()])
         progress.close()
-    return [results[i] for i in range(len(items))]
+    return [results[i] for i in range(len(futures))]
 
 
 def say_failures(label: str, results: Sequence[JobResult[Any]]) -> bool:

@@ -20,6 +20,7 @@ from labstand.cli import main
 from labstand.distributed import ClusterOptions, Progress, open_client, run_jobs
 from sim.effects import EFFECTS
 from tests.hardware_sim.leakcheck import gone
+from tests.ptys import sigint_not_ignored
 
 
 def diagnose_json(
@@ -118,22 +119,23 @@ def test_a_dead_worker_costs_its_campaign_a_retry_and_a_bad_one_fails_alone(
 def test_ctrl_c_shuts_the_cluster_down_and_leaves_no_process(manifest: Path) -> None:
     # As at a terminal: Ctrl-C sends SIGINT to the whole foreground process group, the
     # command and its worker processes alike.
-    process = subprocess.Popen(
-        [
-            sys.executable,
-            "-m",
-            "labstand",
-            "diagnose",
-            "--campaigns",
-            str(manifest),
-            "--workers",
-            "2",
-        ],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-        start_new_session=True,
-    )
+    with sigint_not_ignored():
+        process = subprocess.Popen(
+            [
+                sys.executable,
+                "-m",
+                "labstand",
+                "diagnose",
+                "--campaigns",
+                str(manifest),
+                "--workers",
+                "2",
+            ],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+            start_new_session=True,
+        )
     try:
         assert process.stderr is not None
         line = process.stderr.readline()  # printed once the cluster is up

@@ -21,6 +21,7 @@ from labstand.live.model import ModelBlock
 from labstand.live.player import BLOCK_S, Player
 from recordings import RecordingMetadata, open_recording, open_writer
 from tests.live.conftest import NodeClient, read_url
+from tests.ptys import sigint_not_ignored
 from tests.run.conftest import Outcome
 
 
@@ -195,13 +196,14 @@ def test_busy_port_is_bad_input(s11: Path) -> None:
 def test_loop_plays_again_later_on_the_time_axis(s11: Path, node_client: type[NodeClient]) -> None:
     import signal
 
-    proc = subprocess.Popen(
-        [sys.executable, "-m", "labstand", "play", str(s11), "--speed", "20", "--loop",
-         "--start", "2", "--foxglove", "0"],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )  # fmt: skip
+    with sigint_not_ignored():
+        proc = subprocess.Popen(
+            [sys.executable, "-m", "labstand", "play", str(s11), "--speed", "20", "--loop",
+             "--start", "2", "--foxglove", "0"],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+        )  # fmt: skip
     try:
         assert proc.stdout is not None
         client = node_client(read_url(proc.stdout, []))
