@@ -232,6 +232,9 @@ ReaderFunction = Callable[..., Any]  # (path, *, salvage=False) -> Recording
 #: format modules as they are imported (``register_format``); ``formats()`` imports them all.
 FORMATS: dict[str, tuple[str, WriterFactory | None, ReaderFunction | None]] = {}
 
+#: Suffixes written as one table on the gauge clock (``recordings.tables``, pandas).
+TABLE_SUFFIXES = (".csv", ".parquet")
+
 #: suffix -> the modules that register its reader and writer. A format module is imported
 #: only when a file of its suffix is opened, so reading an MCAP file does not load h5py
 #: and nptdms (the command's start-up time, docs/benchmarks.md).

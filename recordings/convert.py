@@ -11,7 +11,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from recordings.atomic import written_whole
-from recordings.base import EVENTS_DTYPE, open_writer
+from recordings.base import EVENTS_DTYPE, TABLE_SUFFIXES, open_writer
 from recordings.recording import Recording
 from recordings.schema import COMMAND_DTYPE, DRIVE_DTYPE, RecordingMetadata
 
@@ -85,7 +85,7 @@ def write_recording(
     for line in recording.repairs:
         t_ns = int(recording.gauges["t_ns"][-1]) if len(recording.gauges) else 0
         events.append((t_ns, "repair", line))
-    if path.suffix.lower() in (".csv", ".parquet"):  # recordings.tables.TABLE_SUFFIXES
+    if path.suffix.lower() in TABLE_SUFFIXES:
         from recordings.tables import write_table  # pandas: only when a table is written
 
         array = np.array(events, dtype=EVENTS_DTYPE).reshape(len(events))

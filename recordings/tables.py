@@ -34,7 +34,7 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
-from recordings.base import EVENTS_DTYPE, register_format
+from recordings.base import EVENTS_DTYPE, TABLE_SUFFIXES, register_format
 from recordings.csvio import DRIVE_TAG, EVENT_TAG, METADATA_TAG, drive_array
 from recordings.errors import CorruptRecordingError, MissingChannelError
 from recordings.recording import Recording
@@ -43,7 +43,6 @@ from recordings.schema import COMMAND_DTYPE, DRIVE_DTYPE, GAUGES_DTYPE, Recordin
 __all__ = ["TABLE_SUFFIXES", "read_parquet", "write_table"]
 
 #: Suffixes written by ``write_table`` (not streaming writers: ``labstand run`` refuses them).
-TABLE_SUFFIXES = (".csv", ".parquet")
 UNITS = {
     "t_s": "s",
     "t_ns": "ns",

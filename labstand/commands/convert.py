@@ -27,10 +27,9 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
 
 def writable_suffixes() -> list[str]:
     """Every suffix ``write_recording`` writes."""
-    from recordings.base import FORMATS
-    from recordings.tables import TABLE_SUFFIXES
+    from recordings.base import TABLE_SUFFIXES, formats
 
-    return sorted({s for s, (_, writer, _) in FORMATS.items() if writer} | set(TABLE_SUFFIXES))
+    return sorted({s for s, (_, writer, _) in formats().items() if writer} | set(TABLE_SUFFIXES))
 
 
 def check_target(target: Path, source: Path) -> None:

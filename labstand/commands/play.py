@@ -10,12 +10,12 @@ are imported inside ``run``.
 from __future__ import annotations
 
 import argparse
-import signal
-import threading
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
+    import threading
+
     from labstand.live.address import ViewerAddress
     from recordings import Recording
     from sim.params import StandParams
@@ -78,19 +78,10 @@ def run(args: argparse.Namespace) -> int:
             f"(0 … {recording.duration_s:.3f} s)",
             ExitCode.USAGE,
         )
-    # Ctrl-C is remembered as well as raised: a KeyboardInterrupt raised inside the
-    # server's native code can be lost there (seen: a --loop that never ended).
-    interrupted = threading.Event()
+    from labstand.interrupts import remembered_interrupt
 
-    def on_interrupt(signum: int, frame: object) -> None:
-        interrupted.set()
-        raise KeyboardInterrupt
-
-    previous = signal.signal(signal.SIGINT, on_interrupt)
-    try:
+    with remembered_interrupt() as interrupted:
         return _serve(args, address, recording, params, name, interrupted)
-    finally:
-        signal.signal(signal.SIGINT, previous)
 
 
 def _serve(

@@ -12,14 +12,13 @@ import argparse
 import importlib.util
 import logging
 import os
-import signal
-import threading
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from labstand.errors import CommandError, ExitCode
+from labstand.interrupts import remembered_interrupt
 
 if TYPE_CHECKING:  # dask is imported where it runs: a command's --help stays quick
     from distributed import Client
@@ -157,27 +156,3 @@ def _dashboard(client: Client) -> str:
         return "dashboard off (bokeh is not installed)"
     link = client.dashboard_link
     return f"dashboard {link}" if link else "no dashboard"
-
-
-@contextmanager
-def remembered_interrupt() -> Iterator[threading.Event]:
-    """Ctrl-C remembered as well as raised, for the ``with`` block (main thread only).
-
-    A KeyboardInterrupt raised inside Dask's own waiting (starting workers, waiting for
-    results) can be lost there: a run went on to finish every job after Ctrl-C. The
-    event lets the caller raise it again where it looks.
-    """
-    event = threading.Event()
-    if threading.current_thread() is not threading.main_thread():
-        yield event
-        return
-
-    def on_interrupt(signum: int, frame: object) -> None:
-        event.set()
-        raise KeyboardInterrupt
-
-    previous = signal.signal(signal.SIGINT, on_interrupt)
-    try:
-        yield event
-    finally:
-        signal.signal(signal.SIGINT, previous)

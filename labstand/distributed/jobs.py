@@ -21,8 +21,8 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Generic, TypeVar
 
-from labstand.distributed.cluster import remembered_interrupt
 from labstand.distributed.progress import Progress
+from labstand.interrupts import remembered_interrupt
 
 if TYPE_CHECKING:  # dask is imported where it runs: a command's --help stays quick
     from distributed import Client
