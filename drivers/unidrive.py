@@ -138,7 +138,14 @@ class UnidriveSP(DriveInterface):
         return self._limits
 
     # ---- transactions ----------------------------------------------------------------
-    def _transact(self, regs: Sequence[Register], call: Callable[[], ModbusPDU]) -> ModbusPDU:
+    def _transact(
+        self, regs: Sequence[Register], call: Callable[[], ModbusPDU], words: int | None = None
+    ) -> ModbusPDU:
+        """``call`` with retries, its exception replies raised as ours.
+
+        A read reply with another number of registers than ``words`` is garbled (seen over
+        RTU: an empty reply) and counts as no reply.
+        """
         what = _what(regs)
         last: Exception | None = None
         for attempt in range(self.retries + 1):
@@ -164,6 +171,11 @@ class UnidriveSP(DriveInterface):
                 if code == 3:
                     raise DriveValueError(msg, code)
                 raise DriveReplyError(msg, code)
+            got = len(getattr(reply, "registers", None) or [])
+            if words is not None and got != words:
+                last = ModbusIOException(f"{got} registers in the reply, {words} asked")
+                log.warning("%s: %s: garbled reply (attempt %d)", self.name, what, attempt + 1)
+                continue
             return reply
         if isinstance(last, ConnectionException):
             raise DriveConnectionError(f"{self.name}: {what}: {last}") from last
@@ -179,6 +191,7 @@ class UnidriveSP(DriveInterface):
             lambda: self._client.read_holding_registers(
                 regs[0].address, count=count, device_id=self.device_id
             ),
+            count,
         )
         return decode_registers(reply.registers, width)
 
@@ -216,6 +229,7 @@ class UnidriveSP(DriveInterface):
                 values=words,
                 device_id=self.device_id,
             ),
+            2 * len(block),
         )
         self._cw = word
         raw = decode_registers(reply.registers, 32)
