@@ -58,9 +58,6 @@ __all__ = [
 Variant = Mapping[str, float]
 
 _STAND_FIELDS = frozenset(f.name for f in fields(StandParams))
-#: Effects whose own states the gauges cannot see at a restart: carried between segments.
-#: (The pulley seat is not among them: it follows the recorded slack episodes.)
-_CARRIED = ("fibre_transverse_vibration", "stick_slip_friction")
 
 
 class ModelStream(Protocol):
@@ -138,7 +135,8 @@ class Model:
         self.physical = "physical" in kinds
         #: Measurement effects transform the outputs.
         self.measured = "measurement" in kinds
-        self._chained = any(e.name in _CARRIED for e in self.effects)
+        # Effects whose states the gauges cannot see carry them between segments.
+        self._chained = any(EFFECTS[e.name].carried for e in self.effects)
 
     def __repr__(self) -> str:
         names = ", ".join(str(e) for e in self.effects) or "baseline"

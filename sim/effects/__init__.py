@@ -1,5 +1,6 @@
 """The unmodelled effects of STAND.md §5 as switchable augmentations of the baseline model.
 
+Each effect is one module here (``fibre_viscoelastic.py``, ...: its ``INFO``).
 ``EFFECTS`` lists the nine effects with their parameters (units, plausible and admissible
 ranges, defaults); ``sim.model.Model(stand, effects)`` runs the baseline with any
 combination of them; ``sim.effects.realism`` adds measurement noise and draws "real"
@@ -34,6 +35,8 @@ _EXPORTS = {
     "ParamInfo": "sim.effects.registry",
     "parse_effect": "sim.effects.registry",
     "parse_effects": "sim.effects.registry",
+    "register": "sim.effects.registry",
+    "unregister": "sim.effects.registry",
 }
 
 if TYPE_CHECKING:
@@ -51,6 +54,8 @@ if TYPE_CHECKING:
         ParamInfo,
         parse_effect,
         parse_effects,
+        register,
+        unregister,
     )
 
 
@@ -77,4 +82,6 @@ __all__ = [
     "draw_real_stand",
     "parse_effect",
     "parse_effects",
+    "register",
+    "unregister",
 ]

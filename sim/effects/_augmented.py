@@ -10,14 +10,15 @@ measurement effects then act on the outputs (``sim.effects.measure``).
 from __future__ import annotations
 
 from collections.abc import Sequence
+from types import ModuleType
 
 import numpy as np
 from numpy.typing import NDArray
 
 from sim._baseline import DEFAULT_SUBSTEPS, check_input, friction_arrays, param_vector
+from sim.effects import _compose, measure
 from sim.effects import kernel as ek
-from sim.effects import measure
-from sim.effects.registry import EffectError, EffectSpec, check_unique, effect_info
+from sim.effects.registry import EFFECTS, EffectError, EffectSpec, check_unique, effect_info
 from sim.params import FrictionTable, StandParams
 from sim.results import BatchResult, ModelRun
 
@@ -52,13 +53,28 @@ def augmented_row(stand: StandParams, effects: Sequence[EffectSpec] = ()) -> Flo
     row[ek.R_RADIUS] = stand.pulley_radius_m
     for spec in effects:
         info = effect_info(spec.name)
+        if info.check_stand is not None:
+            info.check_stand(stand)
         row[info.flag_column] = 1.0
+        if info.weight_force is not None:
+            row[ek.R_X_ON] = 1.0
         values = spec.resolved()
         for p in info.params:
             row[p.column] = values[p.name]
-    if row[ek.R_PI_ON] > 0 and stand.drive_span_m <= 0:
-        raise EffectError("pulley_inertia_friction needs a positive drive span ℓ₁")
     return row
+
+
+def _kernel(rows: FloatArray) -> ModuleType:
+    """The kernel for these rows: composed with the added effects any of them has on."""
+    rows2 = np.atleast_2d(rows)
+    if not np.any(rows2[:, ek.R_X_ON] > 0):
+        return ek
+    added = tuple(
+        info
+        for info in EFFECTS.values()
+        if info.weight_force is not None and np.any(rows2[:, info.flag_column] > 0)
+    )
+    return _compose.kernel_for(added)
 
 
 def _measure_run(
@@ -96,7 +112,7 @@ def simulate_augmented(
     row = augmented_row(stand, effects)
     knots, coef = friction_arrays(stand.friction)
     u, v, t1, t2 = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
-    most = ek.simulate_into(x, 1.0 / rate_hz, substeps, row, knots, coef, u, v, t1, t2)
+    most = _kernel(row).simulate_into(x, 1.0 / rate_hz, substeps, row, knots, coef, u, v, t1, t2)
     rec_u, rec_f = _measure_run(u, t1, 1.0 / rate_hz, row)
     t = np.arange(n) / rate_hz
     x_out = np.asarray(x_m, dtype=np.float64)
@@ -124,7 +140,7 @@ def simulate_augmented_rows(
     t1, t2 = np.empty((sets, n)), np.empty((sets, n))
     knots, coef = friction_arrays(table)
     dt = 1.0 / rate_hz
-    ek.simulate_batch_into(x2, dt, substeps, rows2, knots, coef, u, v, t1, t2)
+    _kernel(rows2).simulate_batch_into(x2, dt, substeps, rows2, knots, coef, u, v, t1, t2)
     rec_u, rec_f = np.empty_like(u), np.empty_like(t1)
     measure.measure_batch_into(u, t1, dt, measure.measurement_rows(rows2), rec_u, rec_f)
     return BatchResult(np.arange(n) / rate_hz, rec_u, v, rec_f, u, t1)
@@ -186,7 +202,8 @@ def simulate_augmented_segments(
     knots, coef = friction_arrays(table)
     # ``chained``: string modes, bristles and the pulley seat carry over between
     # segments (see simulate_chained_into); the model decides.
-    kernel = ek.simulate_chained_into if chained else ek.simulate_segments_into
+    k = _kernel(rows2)
+    kernel = k.simulate_chained_into if chained else k.simulate_segments_into
     kernel(
         np.ascontiguousarray(x_rel_m, dtype=np.float64), 1.0 / rate_hz, substeps, rows2,
         knots, coef, np.ascontiguousarray(starts, dtype=np.int64),
@@ -224,8 +241,9 @@ class AugmentedStream:
         if self._m[measure.M_CS_ON] > 0 and min(self._skews) < 0:
             raise EffectError("a stream cannot record a channel early (negative skew)")
         knots, coef = friction_arrays(stand.friction)
-        self._c = ek.pack(self._row, knots, coef)
-        self._y = np.array(ek.rest_state(self._c), dtype=np.float64)
+        self._kernel = _kernel(self._row)
+        self._c = self._kernel.pack(self._row, knots, coef)
+        self._y = np.array(self._kernel.rest_state(self._c), dtype=np.float64)
         self._substeps = substeps
         self._x0 = x0_m
         self._last_x = x0_m
@@ -253,7 +271,7 @@ class AugmentedStream:
         x -= self._x0
         u, v, t1, t2 = (np.empty(n + 1) for _ in range(4))
         dt = 1.0 / self.rate_hz
-        ek.advance_into(x, dt, self._substeps, self._c, self._y, u, v, t1, t2)
+        self._kernel.advance_into(x, dt, self._substeps, self._c, self._y, u, v, t1, t2)
         if n:
             self._last_x = float(block[-1])
         return self._measure(u[1:], t1[1:], dt)

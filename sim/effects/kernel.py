@@ -48,7 +48,12 @@ from numba import njit, prange
 (R_FG_ON, R_FG_FC, R_FG_ZETA) = range(44, 47)
 R_PJ_ONSET = 47  # appended (the pulley jump's third and fourth parameters came last)
 R_PJ_DWELL = 48
-N_ROW = 49
+# Effects added outside this file (``sim.effects.registry.register``): R_X_ON is 1.0 when
+# any is on; each has a flag and its parameters in the N_X columns from R_X.
+R_X_ON = 49
+R_X = 50
+N_X = 8
+N_ROW = R_X + N_X
 # Derived constants, then the discrete state, then the friction table: indices into c.
 (D_NSEG, D_T0, D_K1, D_C1, D_K2, D_C2, D_D10, D_D20, D_MP, D_FB0, D_FBL, D_SIGP, D_KB1,
  D_KB2, D_RELAX, D_W1, D_W2, D_F1, D_F2, D_CM1, D_CM2, D_AR1SQ, D_AR2SQ, D_ST1, D_ST2,
@@ -181,7 +186,7 @@ def pack(row, knots, coef):  # type: ignore[no-untyped-def]
     if c[R_SL_ON] > 0.0:
         c[D_SL] = c[R_SL_MU] * c[R_SIN_BETA]
     c[D_OSC], c[D_REAL] = osc, real
-    on = c[R_VE_ON] + c[R_TV_ON] + c[R_PJ_ON] + c[R_PI_ON] + c[R_SS_ON] + c[R_SL_ON]
+    on = c[R_VE_ON] + c[R_TV_ON] + c[R_PJ_ON] + c[R_PI_ON] + c[R_SS_ON] + c[R_SL_ON] + c[R_X_ON]
     c[D_DYN] = 1.0 if on > 0.0 else 0.0
     table = c[P_FRICTION_N] != 0.0 and c[D_SS_ON] == 0.0
     c[D_ZONES] = 1.0 if table or c[R_SL_ON] > 0.0 else 0.0
@@ -238,6 +243,17 @@ def _bearing_limit(c, t1, t2):  # type: ignore[no-untyped-def]
     return (c[D_FB0] + c[D_FBL] * (max(t1, 0.0) + max(t2, 0.0))) / c[D_SIGP]
 
 
+# <added-force>: ``sim.effects._compose`` replaces this function in a composed kernel by
+# the sum of the added effects' forces; in this file no effect is added.
+@njit(cache=True, error_model="numpy")
+def _added_force(c, y, t2):  # type: ignore[no-untyped-def]
+    """Force on the weight (N, up the incline) of the effects added outside this file."""
+    return 0.0
+
+
+# </added-force>
+
+
 @njit(cache=True, error_model="numpy")
 def _rhs(c, y, xa, xd):  # type: ignore[no-untyped-def]
     """dy/dt at drive position xa (rate xd) in the current regimes."""
@@ -258,6 +274,8 @@ def _rhs(c, y, xa, xd):  # type: ignore[no-untyped-def]
         fric += side * zone if zone != 0 else side * v / c[P_VREG]
     drive = -c[P_GRAVITY_N] - fric
     drive += c[P_PROJ] * t2  # + 0.0 while slack: the baseline's sum, bit for bit
+    if c[R_X_ON] > 0.0:
+        drive += _added_force(c, y, t2)
     acc = drive / c[P_MASS]
     s_acc, dq1, dq2, aa1, aa2 = 0.0, 0.0, 0.0, 0.0, 0.0
     if c[D_NSEG] > 1.5:

@@ -146,7 +146,7 @@ def make_campaign(
     effects: list[EffectSpec] = []
     params: dict[str, float] = {}
     if truth != "none":
-        spec = EFFECTS[truth].draw(rng)
+        spec = EffectSpec(truth, EFFECTS[truth].draw(rng))
         effects = [spec]
         params = dict(spec.params)
     noise = NoiseSpec.draw(rng)

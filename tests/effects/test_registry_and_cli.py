@@ -54,8 +54,8 @@ def test_draws_are_reproducible_and_within_the_plausible_range() -> None:
         b = info.draw(np.random.default_rng(7))
         assert a == b
         for p in info.params:
-            assert p.low <= a.params[p.name] <= p.high
-            a.resolved()
+            assert p.low <= a[p.name] <= p.high
+        EffectSpec(info.name, a).resolved()
 
 
 def test_parse_effect_reads_name_and_parameters() -> None:

@@ -1,0 +1,31 @@
+"""The displacement gauge's gain error and offset.
+
+Its transform of the outputs is in ``sim.effects.measure``: the three gauge effects of
+STAND.md §5 run as one compiled chain, in their physical order (the gauge filters, then
+the recorder samples). Equations: docs/effects.md.
+"""
+
+from __future__ import annotations
+
+from sim.effects import kernel as ek
+from sim.effects.info import EffectInfo, param
+
+# fmt: off
+INFO = EffectInfo(
+    "dial_gauge_calibration", "measurement",
+    "u_rec = (1 + gain_error)·u + offset_m",
+    "residual ∝ u in every test; force unaffected",
+    ek.R_DG_ON,
+    (
+        param("gain_error", "1", 0.02, (-0.04, 0.04), (-0.5, 0.5), ek.R_DG_GAIN,
+              "relative gain error of the dial gauge", bounds=(-0.2, 0.2),
+              why="a gauge mounted at an angle to the incline reads u/cos θ (15 % at 30°); "
+                  "a lever gauge's arm angle and a mis-set scale add a few per cent"),
+        # Not fitted: recordings count u from their rest reading, which removes it;
+        # under multiple shooting a fitted offset would pose as a fibre length change.
+        # Still drawn, so the check shows it is harmless.
+        param("offset_m", "m", 0.0, (-2.0e-4, 2.0e-4), (-0.01, 0.01), ek.R_DG_OFFSET,
+              "reading at u = 0", fit=False, drawn=True),
+    ),
+)
+# fmt: on

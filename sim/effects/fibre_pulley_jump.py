@@ -1,0 +1,66 @@
+"""The fibre jumping between two seats on the pulley after slack episodes.
+
+Its terms are in the shared kernel (``sim.effects.kernel``, columns ``ek.R_*``): the nine
+effects of STAND.md §5 meet in one event-located integrator (segments, slack switches,
+friction branches) that a composed kernel would have to split. Equations: docs/effects.md.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from sim.effects import kernel as ek
+from sim.effects.info import EffectInfo, Measured, param
+
+FloatArray = NDArray[np.float64]
+
+
+def _start_state(
+    row: FloatArray, measured: Measured, starts: NDArray[np.int64], init: FloatArray
+) -> None:
+    # The seat follows the recorded slack episodes (``kernel.measured_seats``). Slack: the
+    # force below 5 % of the rest tension, well above the gauge's noise and hum (tenths
+    # of a newton) and far below a taut fibre's force.
+    slack_n = 0.05 * row[ek.P_GRAVITY_N] / row[ek.P_PROJ]
+    init[:, ek.I_LOFF : ek.I_SLACKT + 1] = ek.measured_seats(
+        row, measured.x_rel_m, measured.u_m, measured.force_n, 1.0 / measured.rate_hz,
+        slack_n, starts,
+    )  # fmt: skip
+
+
+# fmt: off
+INFO = EffectInfo(
+    "fibre_pulley_jump", "physical",
+    "once the slack is onset_m deep and has lasted dwell_s the fibre leaves its groove and "
+    "re-seats in the other of two seats, changing the effective length by "
+    "step_m·(1 − exp(−(slack depth − onset_m)/depth_scale_m))",
+    "offset steps in force and position right after slack episodes",
+    ek.R_PJ_ON,
+    (
+        param("step_m", "m", 2.0e-4, (1.0e-4, 5.0e-4), (-1.0e-2, 1.0e-2), ek.R_PJ_STEP,
+              "length change of the second seat (+: effective fibre shorter)", log=True,
+              bounds=(-3.0e-3, 3.0e-3),
+              why="re-seating across an 80 mm pulley's groove or onto its flange changes the "
+                  "fibre path by up to a few millimetres, either way"),
+        param("depth_scale_m", "m", 1.0e-3, (5.0e-4, 5.0e-3), (1.0e-6, 0.1), ek.R_PJ_DEPTH,
+              "slack depth over which the fibre completes its jump", log=True,
+              bounds=(1.0e-5, 3.0e-2),
+              why="from a snap (a hundredth of a millimetre of further slack) to a slow "
+                  "slide over a loop as high as the flange (a few cm)"),
+        param("onset_m", "m", 0.0, (0.0, 1.0e-3), (0.0, 0.05), ek.R_PJ_ONSET,
+              "slack depth at which the fibre leaves its groove", bounds=(0.0, 5.0e-3),
+              why="a fibre held in its groove by friction leaves it only once its loop is "
+                  "as deep as the groove or the flange: 0 to a few millimetres"),
+        param("dwell_s", "s", 0.0, (0.0, 0.05), (0.0, 1.0), ek.R_PJ_DWELL,
+              "time the fibre lies slack before it leaves its groove", bounds=(0.0, 0.2),
+              why="a loose loop slides out of a groove a few millimetres deep under its own "
+                  "weight and the groove's friction within tens of milliseconds "
+                  "(free fall over 1–10 mm takes 14–45 ms); at once when it is flicked out",
+              # 0, then 2 ms to 0.2 s in steps of 20 %: finer than the spread of the
+              # slack episodes' lengths (tens of ms) the threshold must fall between.
+              scan=(0.0, *(float(v) for v in np.geomspace(2.0e-3, 0.2, 26)))),
+    ),
+    start_state=_start_state,
+)
+# fmt: on

@@ -1,0 +1,63 @@
+"""The fibre's viscoelasticity: a Maxwell branch beside the fibre's spring and damper.
+
+Its terms are in the shared kernel (``sim.effects.kernel``, columns ``ek.R_*``): the nine
+effects of STAND.md §5 meet in one event-located integrator (segments, slack switches,
+friction branches) that a composed kernel would have to split. Equations: docs/effects.md.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.signal import lfilter
+
+from sim.effects import kernel as ek
+from sim.effects.info import EffectInfo, Measured, param
+
+FloatArray = NDArray[np.float64]
+
+
+def branch_elongation(row: FloatArray, measured: Measured) -> FloatArray:
+    """The Maxwell branch's elongation q/k₂ along the trace, from the measured history.
+
+    q̇ = k₂·δ̇ − q/τ while taut and q̇ = −q/τ while slack: q/k₂ is the elongation
+    max(δ, 0) high-passed with time constant τ (first order, discretised exactly for a
+    step input).
+    """
+    delta = np.maximum(
+        row[ek.P_PRELOAD] + measured.x_rel_m - row[ek.P_PROJ] * measured.u_rec_m, 0.0
+    )
+    a = float(np.exp(-1.0 / (measured.rate_hz * row[ek.R_VE_TAU])))
+    # y_k = a·y_{k−1} + (δ_k − δ_{k−1}), from rest (y = 0 at the start).
+    d = np.diff(delta, prepend=delta[0])
+    out: FloatArray = lfilter([1.0], [1.0, -a], d)
+    return out
+
+
+def _start_state(
+    row: FloatArray, measured: Measured, starts: NDArray[np.int64], init: FloatArray
+) -> None:
+    init[:, ek.I_HP] = branch_elongation(row, measured)[starts]
+
+
+# fmt: off
+INFO = EffectInfo(
+    "fibre_viscoelastic", "physical",
+    "standard linear solid: a Maxwell branch (spring k₂ in series with a dashpot "
+    "c₂ = k₂·τ) parallel to the fibre's k, c; relaxes while slack",
+    "force peaks and ringing damping change with drive rate; slow motion unaffected",
+    ek.R_VE_ON,
+    (
+        param("branch_stiffness_n_m", "N/m", 2.0e4, (3.0e3, 6.0e4), (0.0, 1.0e6), ek.R_VE_K,
+              "k₂, stiffness of the Maxwell branch (whole fibre)", log=True,
+              bounds=(5.0e2, 2.0e5),
+              why="a polymer-matrix fibre's dynamic stiffness exceeds its static one by a "
+                  "few per cent up to several times (k is 34–94 kN/m)"),
+        param("relaxation_time_s", "s", 0.03, (5.0e-3, 0.1), (1.0e-4, 10.0), ek.R_VE_TAU,
+              "τ = c₂/k₂, the branch's relaxation time", log=True, bounds=(5.0e-4, 1.0),
+              why="faster than one 2 kHz sample it is plain damping; slower than the slowest "
+                  "cycle (≈ 1–2.5 s) it is extra stiffness that k absorbs"),
+    ),
+    start_state=_start_state,
+)
+# fmt: on

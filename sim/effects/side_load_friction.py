@@ -1,0 +1,26 @@
+"""Extra guide friction from the fibre's lateral pull on the weight.
+
+Its terms are in the shared kernel (``sim.effects.kernel``, columns ``ek.R_*``): the nine
+effects of STAND.md §5 meet in one event-located integrator (segments, slack switches,
+friction branches) that a composed kernel would have to split. Equations: docs/effects.md.
+"""
+
+from __future__ import annotations
+
+from sim.effects import kernel as ek
+from sim.effects.info import EffectInfo, param
+
+# fmt: off
+INFO = EffectInfo(
+    "side_load_friction", "physical",
+    "the lateral pull T·sin β presses the weight on the guide wall: extra friction "
+    "μ_s·T·sin β (T the weight-side tension), zero while slack",
+    "friction that grows with tension and vanishes when slack",
+    ek.R_SL_ON,
+    (
+        param("friction_coeff", "1", 0.1, (0.03, 0.3), (0.0, 2.0), ek.R_SL_MU,
+              "μ_s, friction coefficient of the guide wall", bounds=(0.0, 0.8),
+              why="steel or aluminium on a dry guide wall: up to 0.6–0.8"),
+    ),
+)
+# fmt: on

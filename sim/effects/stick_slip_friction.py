@@ -1,0 +1,34 @@
+"""Stick-slip of the weight on its guide: LuGre friction with a Stribeck rise.
+
+Its terms are in the shared kernel (``sim.effects.kernel``, columns ``ek.R_*``): the nine
+effects of STAND.md §5 meet in one event-located integrator (segments, slack switches,
+friction branches) that a composed kernel would have to split. Equations: docs/effects.md.
+"""
+
+from __future__ import annotations
+
+from sim.effects import kernel as ek
+from sim.effects.info import EffectInfo, param
+
+# fmt: off
+INFO = EffectInfo(
+    "stick_slip_friction", "physical",
+    "LuGre friction: bristle state z, ż = v − σ₀|v|z/g(v), F = σ₀z + σ₁ż with "
+    "g(v) = table friction·(1 + r·exp(−(v/v_s)²)); needs the stand's friction table",
+    "residual at velocity reversals and at low speed, visible in slow tests",
+    ek.R_SS_ON,
+    (
+        param("static_ratio", "1", 0.4, (0.1, 0.8), (0.0, 5.0), ek.R_SS_RATIO,
+              "r: static friction exceeds kinetic by this fraction", bounds=(0.0, 3.0),
+              why="static/kinetic friction ratios of steel on lubricated or dry guides lie "
+                  "between 1 and about 4"),
+        param("stribeck_speed_m_s", "m/s", 3.0e-3, (1.0e-3, 1.0e-2), (1.0e-5, 1.0), ek.R_SS_VS,
+              "v_s: speed over which friction falls to kinetic", log=True,
+              bounds=(1.0e-4, 0.1),
+              why="lubricated line contacts show Stribeck speeds from 0.1 mm/s to 0.1 m/s"),
+        param("bristle_stiffness_n_m", "N/m", 1.0e5, (3.0e4, 3.0e5), (1.0e3, 1.0e7),
+              ek.R_SS_SIGMA, "σ₀, presliding stiffness (σ₁ = 2√(σ₀m))", fit=False, log=True),
+    ),
+    carried=True,
+)
+# fmt: on
