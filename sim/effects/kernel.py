@@ -22,7 +22,10 @@ Speed: the hot functions take c and scalars or tuples only; passing arrays to sm
 jitted functions costs 7 machine words per array per call (measured: 60 → 9 ms for 10 s
 at 2 kHz). All numba code of the augmented dynamics lives in this one file on purpose:
 numba's cache does not notice changes in jitted functions imported from other modules,
-so splitting it would let stale machine code survive an edit.
+so splitting it would let stale machine code survive an edit. An effect added from
+outside (``sim.effects.registry.register``) runs in a copy of this file composed with
+its force (``sim.effects._compose``), named by a hash of both sources for that reason.
+Each effect's parameters, ranges and hooks are in its own module (``sim/effects/*.py``).
 """
 
 from __future__ import annotations
