@@ -3,6 +3,7 @@ through the model (a kernel composed with its force) and is named by a diagnosis
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -52,6 +53,10 @@ def test_registering_gives_it_free_kernel_columns_and_a_name(added: EffectInfo) 
         register(weight_viscous_damping.INFO)
     with pytest.raises(EffectError, match="cannot be removed"):
         unregister("fibre_viscoelastic")
+    too_big = dataclasses.replace(added, name="too_big", params=added.params * 8)
+    with pytest.raises(EffectError, match="no room"):
+        register(too_big)
+    assert "too_big" not in EFFECTS
 
 
 def test_its_force_enters_the_weights_balance(stand: StandConfig, added: EffectInfo) -> None:
