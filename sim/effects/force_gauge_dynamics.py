@@ -1,8 +1,7 @@
 """The force gauge and its amplifier: a second-order low-pass.
 
-Its transform of the outputs is in ``sim.effects.measure``: the three gauge effects of
-STAND.md §5 run as one compiled chain, in their physical order (the gauge filters, then
-the recorder samples). Equations: docs/effects.md.
+Output transform: ``sim.effects.measure`` (one chain for the three gauge effects, in
+physical order); equations: docs/effects.md.
 """
 
 from __future__ import annotations

@@ -1,8 +1,6 @@
 """Extra guide friction from the fibre's lateral pull on the weight.
 
-Its terms are in the shared kernel (``sim.effects.kernel``, columns ``ek.R_*``): the nine
-effects of STAND.md §5 meet in one event-located integrator (segments, slack switches,
-friction branches) that a composed kernel would have to split. Equations: docs/effects.md.
+Terms: ``sim.effects.kernel`` (why there: docs/architecture.md); equations: docs/effects.md.
 """
 
 from __future__ import annotations
