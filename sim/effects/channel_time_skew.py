@@ -23,6 +23,7 @@ def _true_channels(
     return u_m + row[ek.R_CS_DISP] * v_m_s, v_m_s
 
 
+# The same declarative shape in every effect module (what it means: sim/effects/info.py).
 # fmt: off
 INFO = EffectInfo(
     "channel_time_skew", "measurement",

@@ -27,6 +27,7 @@ def _start_state(
     )  # fmt: skip
 
 
+# The same declarative shape in every effect module (what it means: sim/effects/info.py).
 # fmt: off
 INFO = EffectInfo(
     "fibre_pulley_jump", "physical",

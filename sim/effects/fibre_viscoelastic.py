@@ -38,6 +38,7 @@ def _start_state(
     init[:, ek.I_HP] = branch_elongation(row, measured)[starts]
 
 
+# The same declarative shape in every effect module (what it means: sim/effects/info.py).
 # fmt: off
 INFO = EffectInfo(
     "fibre_viscoelastic", "physical",

@@ -15,6 +15,7 @@ def _check_stand(stand: StandParams) -> None:
         raise EffectError("pulley_inertia_friction needs a positive drive span ℓ₁")
 
 
+# The same declarative shape in every effect module (what it means: sim/effects/info.py).
 # fmt: off
 INFO = EffectInfo(
     "pulley_inertia_friction", "physical",

@@ -8,6 +8,7 @@ from __future__ import annotations
 from sim.effects import kernel as ek
 from sim.effects.info import EffectInfo, param
 
+# The same declarative shape in every effect module (what it means: sim/effects/info.py).
 # fmt: off
 INFO = EffectInfo(
     "stick_slip_friction", "physical",
