@@ -13,10 +13,10 @@ The model alone decides how: without physical effects it runs the baseline's fas
 (``sim.kernel``), with them the augmented kernel (``sim.effects.kernel``, or a copy
 composed with the forces of effects added by ``register``: ``sim.effects._compose``);
 measurement effects (gauge calibration, skew, gauge dynamics) then transform the
-outputs. Segment
-runs restart from measured channels: the model inverts its own gauge effects to get the
-true state, sets the effects' states from the measurements, and carries over from the
-previous segment the states the gauges cannot see (string modes, LuGre bristle). The kernels are private to ``sim`` (an import-linter contract).
+outputs. Segment runs restart from measured channels: the model inverts its own gauge
+effects to get the true state, sets the effects' states from the measurements, and
+carries over from the previous segment the states the gauges cannot see (string modes,
+LuGre bristle). The kernels are private to ``sim`` (an import-linter contract).
 
 Variants name the parameters they change: a ``StandParams`` field (``stiffness_n_m``,
 ``damping_n_s_m``, ``friction_scale``, ``mass_kg``, ...) or ``"<effect>.<param>"`` of an
