@@ -6,7 +6,11 @@ Side by side in one run, on the same machine and the same equations:
    motion repeated for 60 s, 8.131 kg, final parameters: slack and snatches every cycle);
 2. the kernel, a batch of 256 parameter sets (stiffness, damping, friction ±25 %);
 3. solve_ivp on the same right-hand side (sim/reference.py) at *matching accuracy*: the
-   loosest tolerance whose NRMSE against a tight reference is no worse than the kernel's.
+   loosest tolerance whose NRMSE against a tight reference is no worse than the kernel's;
+4. the composed kernel: the kernel with one built-in physical effect (side_load_friction at
+   μ_s = 0) against a kernel composed with an added effect (the tenth of
+   tests/effects/weight_viscous_damping.py, registered here, at b = 0): the same
+   arithmetic plus the added force's call.
 
 Run: ``make bench`` or ``.venv/bin/python benchmarks/bench_model.py [--seconds 60]``.
 """
@@ -16,16 +20,25 @@ from __future__ import annotations
 import argparse
 import os
 import platform
+import sys
+import tempfile
 import time
+from collections.abc import Callable, Sequence
+from pathlib import Path
 
 import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # the added effect is in tests/
 
 from drivers.signals import SignalSpec, plan_motion
 from sim import _baseline
 from sim.config import default_config
-from sim.model import Model
+from sim.effects import EffectSpec, register, unregister
+from sim.model import Model, Variant
+from sim.params import StandParams
 from sim.reference import solve_reference
 from sim.situations import situation
+from tests.effects import weight_viscous_damping
 
 RATE = 2000.0
 
@@ -43,6 +56,66 @@ def best_of(fn, repeats: int) -> float:  # type: ignore[no-untyped-def]
     return min(times)
 
 
+def best_of_pair(
+    a: Callable[[], object], b: Callable[[], object], repeats: int
+) -> tuple[float, float]:
+    """Best times of two runs taken in turns (a, b, a, b, ...): load changes hit both alike."""
+    times: tuple[list[float], list[float]] = ([], [])
+    for _ in range(repeats):
+        for fn, out in ((a, times[0]), (b, times[1])):
+            start = time.perf_counter()
+            fn()
+            out.append(time.perf_counter() - start)
+    return min(times[0]), min(times[1])
+
+
+def composed_kernel(
+    x: np.ndarray, params: StandParams, variants: Sequence[Variant], sim_s: float
+) -> None:
+    """A built-in physical effect against an added one (a composed kernel), both at zero."""
+    print("composed kernel (compile excluded; runs taken in turns, best of each):")
+    saved = os.environ.get("LABSTAND_KERNEL_CACHE")
+    with tempfile.TemporaryDirectory(prefix="labstand-kernels-") as cache:
+        os.environ["LABSTAND_KERNEL_CACHE"] = cache  # a fresh composed kernel, compiled here
+        info = register(weight_viscous_damping.INFO)
+        try:
+            builtin = Model(params, [EffectSpec("side_load_friction", {"friction_coeff": 0.0})])
+            added = Model(params, [EffectSpec(info.name, {"damping_n_s_m": 0.0})])
+            builtin.run(x[:100], RATE)
+            builtin.run_batch(x[:100], RATE, variants[:2])
+            start = time.perf_counter()
+            added.run(x[:100], RATE)
+            added.run_batch(x[:100], RATE, variants[:2])
+            compose_s = time.perf_counter() - start
+            print(f"  composing and compiling the added effect's kernel (once): {compose_s:6.1f} s")
+            one_a, one_b = best_of_pair(lambda: builtin.run(x, RATE), lambda: added.run(x, RATE), 5)
+            diff = np.max(np.abs(builtin.run(x, RATE).force_n - added.run(x, RATE).force_n))
+            print(
+                f"  single, built-in side_load_friction (mu_s 0): {one_a * 1e3:8.1f} ms  "
+                f"-> {sim_s / one_a:8.0f}x real time"
+            )
+            print(
+                f"  single, composed with {info.name} (b 0): {one_b * 1e3:8.1f} ms  "
+                f"-> {sim_s / one_b:8.0f}x real time;  composed / built-in {one_b / one_a:.3f}"
+            )
+            print(f"  largest force difference between the two runs: {diff:.1e} N")
+            many_a, many_b = best_of_pair(
+                lambda: builtin.run_batch(x, RATE, variants),
+                lambda: added.run_batch(x, RATE, variants),
+                2,
+            )
+            print(
+                f"  batch of {len(variants)}, built-in: {many_a:8.2f} s;  composed: "
+                f"{many_b:8.2f} s;  composed / built-in {many_b / many_a:.3f}"
+            )
+        finally:
+            unregister(info.name)
+            if saved is None:
+                del os.environ["LABSTAND_KERNEL_CACHE"]
+            else:
+                os.environ["LABSTAND_KERNEL_CACHE"] = saved
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seconds", type=float, default=60.0, help="simulated duration, s")
@@ -52,6 +125,12 @@ def main() -> None:
         type=float,
         default=10.0,
         help="window used to match solve_ivp's accuracy to the kernel's, s",
+    )
+    parser.add_argument(
+        "--composed-batch",
+        type=int,
+        default=64,
+        help="parameter sets in the composed kernel's batch",
     )
     args = parser.parse_args()
 
@@ -98,6 +177,7 @@ def main() -> None:
         f"real time ({batch / args.batch * 1e3:.1f} ms per set)"
     )
     print(f"  same batch on the private kernel entry (no front door): {direct_batch:8.2f} s")
+    composed_kernel(x, params, variants[: args.composed_batch], sim_s)
 
     # Accuracy matching on a window (the tight reference is slow).
     n_match = int(args.match_seconds * RATE) + 1
