@@ -24,6 +24,7 @@ import sys
 import tempfile
 import time
 from collections.abc import Callable, Sequence
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -56,22 +57,18 @@ def best_of(fn, repeats: int) -> float:  # type: ignore[no-untyped-def]
     return min(times)
 
 
-def best_of_pair(
-    a: Callable[[], object], b: Callable[[], object], repeats: int
-) -> tuple[float, float]:
-    """Best times of two runs taken in turns (a, b, a, b, ...): load changes hit both alike."""
-    times: tuple[list[float], list[float]] = ([], [])
+def best_in_turns(fns: Sequence[Callable[[], object]], repeats: int) -> list[float]:
+    """Best time of each run, taken in turns (a, b, c, a, b, c, ...): load hits all alike."""
+    times: list[list[float]] = [[] for _ in fns]
     for _ in range(repeats):
-        for fn, out in ((a, times[0]), (b, times[1])):
+        for fn, out in zip(fns, times, strict=True):
             start = time.perf_counter()
             fn()
             out.append(time.perf_counter() - start)
-    return min(times[0]), min(times[1])
+    return [min(t) for t in times]
 
 
-def composed_kernel(
-    x: np.ndarray, params: StandParams, variants: Sequence[Variant], sim_s: float
-) -> None:
+def composed_kernel(x: np.ndarray, params: StandParams, variants: Sequence[Variant]) -> None:
     """A built-in physical effect against an added one (a composed kernel), both at zero."""
     print("composed kernel (compile excluded; runs taken in turns, best of each):")
     saved = os.environ.get("LABSTAND_KERNEL_CACHE")
@@ -79,35 +76,37 @@ def composed_kernel(
         os.environ["LABSTAND_KERNEL_CACHE"] = cache  # a fresh composed kernel, compiled here
         info = register(weight_viscous_damping.INFO)
         try:
-            builtin = Model(params, [EffectSpec("side_load_friction", {"friction_coeff": 0.0})])
-            added = Model(params, [EffectSpec(info.name, {"damping_n_s_m": 0.0})])
+            side = EffectSpec("side_load_friction", {"friction_coeff": 0.0})
+            damping = EffectSpec(info.name, {"damping_n_s_m": 0.0})
+            models = {
+                "built-in side_load_friction (mu_s 0)": Model(params, [side]),
+                f"composed, {info.name} (b 0)": Model(params, [damping]),
+                "composed, both (the built-in's arithmetic + the call)": Model(
+                    params, [side, damping]
+                ),
+            }
+            builtin = next(iter(models.values()))
             builtin.run(x[:100], RATE)
             builtin.run_batch(x[:100], RATE, variants[:2])
             start = time.perf_counter()
-            added.run(x[:100], RATE)
-            added.run_batch(x[:100], RATE, variants[:2])
+            for model in list(models.values())[1:]:
+                model.run(x[:100], RATE)
+                model.run_batch(x[:100], RATE, variants[:2])
             compose_s = time.perf_counter() - start
             print(f"  composing and compiling the added effect's kernel (once): {compose_s:6.1f} s")
-            one_a, one_b = best_of_pair(lambda: builtin.run(x, RATE), lambda: added.run(x, RATE), 5)
-            diff = np.max(np.abs(builtin.run(x, RATE).force_n - added.run(x, RATE).force_n))
-            print(
-                f"  single, built-in side_load_friction (mu_s 0): {one_a * 1e3:8.1f} ms  "
-                f"-> {sim_s / one_a:8.0f}x real time"
+            singles = best_in_turns([partial(m.run, x, RATE) for m in models.values()], 5)
+            batches = best_in_turns(
+                [partial(m.run_batch, x, RATE, variants) for m in models.values()], 2
             )
-            print(
-                f"  single, composed with {info.name} (b 0): {one_b * 1e3:8.1f} ms  "
-                f"-> {sim_s / one_b:8.0f}x real time;  composed / built-in {one_b / one_a:.3f}"
-            )
-            print(f"  largest force difference between the two runs: {diff:.1e} N")
-            many_a, many_b = best_of_pair(
-                lambda: builtin.run_batch(x, RATE, variants),
-                lambda: added.run_batch(x, RATE, variants),
-                2,
-            )
-            print(
-                f"  batch of {len(variants)}, built-in: {many_a:8.2f} s;  composed: "
-                f"{many_b:8.2f} s;  composed / built-in {many_b / many_a:.3f}"
-            )
+            print(f"  {'':54s} {'one run':>10s} {f'batch of {len(variants)}':>12s}  / built-in")
+            for name, one, many in zip(models, singles, batches, strict=True):
+                print(
+                    f"  {name:54s} {one * 1e3:7.1f} ms {many:10.2f} s  "
+                    f"{one / singles[0]:.3f} {many / batches[0]:.3f}"
+                )
+            forces = [m.run(x, RATE).force_n for m in models.values()]
+            diff = max(float(np.max(np.abs(f - forces[0]))) for f in forces[1:])
+            print(f"  largest force difference from the built-in's run: {diff:.1e} N")
         finally:
             unregister(info.name)
             if saved is None:
@@ -177,7 +176,7 @@ def main() -> None:
         f"real time ({batch / args.batch * 1e3:.1f} ms per set)"
     )
     print(f"  same batch on the private kernel entry (no front door): {direct_batch:8.2f} s")
-    composed_kernel(x, params, variants[: args.composed_batch], sim_s)
+    composed_kernel(x, params, variants[: args.composed_batch])
 
     # Accuracy matching on a window (the tight reference is slow).
     n_match = int(args.match_seconds * RATE) + 1
