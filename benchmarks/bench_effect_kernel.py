@@ -7,7 +7,9 @@ kernel does, and the diagnosis' candidate refits spend most of their time in it.
 round runs this script's measurement in a fresh process from this tree and, with
 ``--before``, from the other tree (e.g. ``git worktree add --detach /tmp/before COMMIT``),
 in turns, so that the load of this shared machine falls on both alike; the table gives
-the best of the rounds. Measured: situation 11's motion for 60 s at 2 kHz, 8.131 kg,
+the best of the rounds, wall time and the process's CPU time (user + sys, all threads:
+a batch runs on both cores, and when other sessions hold one its wall time doubles, its
+CPU time much less). Measured: situation 11's motion for 60 s at 2 kHz, 8.131 kg,
 ``Model(stand, [effect]).run`` (best of 5) and ``run_batch`` of 32 parameter sets (best
 of 2), for one cheap and one costly physical effect and all six physical ones together.
 Compile time is excluded (each process compiles nothing once numba's cache is warm:
@@ -42,17 +44,19 @@ CASES = {
 }
 
 
-def best_of(fn: Callable[[], object], repeats: int) -> float:
-    times = []
+def best_of(fn: Callable[[], object], repeats: int) -> list[float]:
+    """[best wall time, best CPU time of the process] (s) of ``repeats`` calls."""
+    walls, cpus = [], []
     for _ in range(repeats):
-        start = time.perf_counter()
+        start, cpu = time.perf_counter(), time.process_time()
         fn()
-        times.append(time.perf_counter() - start)
-    return min(times)
+        walls.append(time.perf_counter() - start)
+        cpus.append(time.process_time() - cpu)
+    return [min(walls), min(cpus)]
 
 
 def measure(seconds: float, batch: int) -> dict[str, list[float]]:
-    """{case: [single run s, batch s]} in this process (the tree on sys.path)."""
+    """{case: [run, run CPU, batch, batch CPU] (s)} in this process (its tree on sys.path)."""
     import numpy as np
 
     from drivers.signals import SignalSpec, plan_motion
@@ -83,7 +87,7 @@ def measure(seconds: float, batch: int) -> dict[str, list[float]]:
         model.run_batch(x[:100], RATE, variants[:2])
         single = best_of(partial(model.run, x, RATE), 5)
         many = best_of(partial(model.run_batch, x, RATE, variants), 2)
-        out[case] = [single, many]
+        out[case] = single + many
     return out
 
 
@@ -110,20 +114,28 @@ def main() -> None:
     args = parser.parse_args()
     trees = {"now": HERE} | ({"before": args.before.resolve()} if args.before else {})
     best: dict[str, dict[str, list[float]]] = {}
+    loads = []
     for _ in range(args.rounds):
         for label, tree in reversed(trees.items()):  # before, now, before, now, ...
+            loads.append(os.getloadavg()[0])
             for case, times in child(tree, args.seconds, args.batch).items():
                 old = best.setdefault(label, {}).setdefault(case, times)
                 best[label][case] = [min(a, b) for a, b in zip(old, times, strict=True)]
-    print(f"load average {os.getloadavg()[0]:.1f}; best of {args.rounds} rounds per tree")
-    print(f"{'case':28s} {'tree':7s} {'one run':>10s} {f'batch of {args.batch}':>12s}")
+    print(
+        f"load average {min(loads):.1f}-{max(loads):.1f} (1 min, at each process start); "
+        f"best of {args.rounds} rounds per tree; CPU: user + sys of all threads"
+    )
+    head = ["one run", "CPU", f"batch of {args.batch}", "CPU"]
+    print(f"{'case':26s} {'tree':10s}" + "".join(f"{h:>14s}" for h in head))
     for case in CASES:
         for label in trees:
-            single, many = best[label][case]
-            print(f"{case:28s} {label:7s} {single * 1e3:8.1f} ms {many:10.2f} s")
+            cells = [f"{v * 1e3:11.1f} ms" for v in best[label][case][:2]]
+            cells += [f"{v:12.2f} s" for v in best[label][case][2:]]
+            print(f"{case:26s} {label:10s}" + "".join(cells))
         if "before" in best:
             now, before = best["now"][case], best["before"][case]
-            print(f"{'':28s} now/before {now[0] / before[0]:6.3f}   {now[1] / before[1]:10.3f}")
+            ratios = "".join(f"{a / b:14.3f}" for a, b in zip(now, before, strict=True))
+            print(f"{'':26s} {'now/before':10s}" + ratios)
 
 
 if __name__ == "__main__":
