@@ -6,7 +6,11 @@ Side by side in one run, on the same machine and the same equations:
    motion repeated for 60 s, 8.131 kg, final parameters: slack and snatches every cycle);
 2. the kernel, a batch of 256 parameter sets (stiffness, damping, friction ±25 %);
 3. solve_ivp on the same right-hand side (sim/reference.py) at *matching accuracy*: the
-   loosest tolerance whose NRMSE against a tight reference is no worse than the kernel's.
+   loosest tolerance whose NRMSE against a tight reference is no worse than the kernel's;
+4. the composed kernel: the kernel with one built-in physical effect (side_load_friction at
+   μ_s = 0) against a kernel composed with an added effect (the tenth of
+   tests/effects/weight_viscous_damping.py, registered here, at b = 0): the same
+   arithmetic plus the added force's call.
 
 Run: ``make bench`` or ``.venv/bin/python benchmarks/bench_model.py [--seconds 60]``.
 """
@@ -16,16 +20,26 @@ from __future__ import annotations
 import argparse
 import os
 import platform
+import sys
+import tempfile
 import time
+from collections.abc import Callable, Sequence
+from functools import partial
+from pathlib import Path
 
 import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # the added effect is in tests/
 
 from drivers.signals import SignalSpec, plan_motion
 from sim import _baseline
 from sim.config import default_config
-from sim.model import Model
+from sim.effects import EffectSpec, register, unregister
+from sim.model import Model, Variant
+from sim.params import StandParams
 from sim.reference import solve_reference
 from sim.situations import situation
+from tests.effects import weight_viscous_damping
 
 RATE = 2000.0
 
@@ -43,6 +57,64 @@ def best_of(fn, repeats: int) -> float:  # type: ignore[no-untyped-def]
     return min(times)
 
 
+def best_in_turns(fns: Sequence[Callable[[], object]], repeats: int) -> list[float]:
+    """Best time of each run, taken in turns (a, b, c, a, b, c, ...): load hits all alike."""
+    times: list[list[float]] = [[] for _ in fns]
+    for _ in range(repeats):
+        for fn, out in zip(fns, times, strict=True):
+            start = time.perf_counter()
+            fn()
+            out.append(time.perf_counter() - start)
+    return [min(t) for t in times]
+
+
+def composed_kernel(x: np.ndarray, params: StandParams, variants: Sequence[Variant]) -> None:
+    """A built-in physical effect against an added one (a composed kernel), both at zero."""
+    print("composed kernel (compile excluded; runs taken in turns, best of each):")
+    saved = os.environ.get("LABSTAND_KERNEL_CACHE")
+    with tempfile.TemporaryDirectory(prefix="labstand-kernels-") as cache:
+        os.environ["LABSTAND_KERNEL_CACHE"] = cache  # a fresh composed kernel, compiled here
+        info = register(weight_viscous_damping.INFO)
+        try:
+            side = EffectSpec("side_load_friction", {"friction_coeff": 0.0})
+            damping = EffectSpec(info.name, {"damping_n_s_m": 0.0})
+            models = {
+                "built-in side_load_friction (mu_s 0)": Model(params, [side]),
+                f"composed, {info.name} (b 0)": Model(params, [damping]),
+                "composed, both (the built-in's arithmetic + the call)": Model(
+                    params, [side, damping]
+                ),
+            }
+            builtin = next(iter(models.values()))
+            builtin.run(x[:100], RATE)
+            builtin.run_batch(x[:100], RATE, variants[:2])
+            start = time.perf_counter()
+            for model in list(models.values())[1:]:
+                model.run(x[:100], RATE)
+                model.run_batch(x[:100], RATE, variants[:2])
+            compose_s = time.perf_counter() - start
+            print(f"  composing and compiling the added effect's kernel (once): {compose_s:6.1f} s")
+            singles = best_in_turns([partial(m.run, x, RATE) for m in models.values()], 5)
+            batches = best_in_turns(
+                [partial(m.run_batch, x, RATE, variants) for m in models.values()], 2
+            )
+            print(f"  {'':54s} {'one run':>10s} {f'batch of {len(variants)}':>12s}  / built-in")
+            for name, one, many in zip(models, singles, batches, strict=True):
+                print(
+                    f"  {name:54s} {one * 1e3:7.1f} ms {many:10.2f} s  "
+                    f"{one / singles[0]:.3f} {many / batches[0]:.3f}"
+                )
+            forces = [m.run(x, RATE).force_n for m in models.values()]
+            diff = max(float(np.max(np.abs(f - forces[0]))) for f in forces[1:])
+            print(f"  largest force difference from the built-in's run: {diff:.1e} N")
+        finally:
+            unregister(info.name)
+            if saved is None:
+                del os.environ["LABSTAND_KERNEL_CACHE"]
+            else:
+                os.environ["LABSTAND_KERNEL_CACHE"] = saved
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seconds", type=float, default=60.0, help="simulated duration, s")
@@ -52,6 +124,12 @@ def main() -> None:
         type=float,
         default=10.0,
         help="window used to match solve_ivp's accuracy to the kernel's, s",
+    )
+    parser.add_argument(
+        "--composed-batch",
+        type=int,
+        default=64,
+        help="parameter sets in the composed kernel's batch",
     )
     args = parser.parse_args()
 
@@ -98,6 +176,7 @@ def main() -> None:
         f"real time ({batch / args.batch * 1e3:.1f} ms per set)"
     )
     print(f"  same batch on the private kernel entry (no front door): {direct_batch:8.2f} s")
+    composed_kernel(x, params, variants[: args.composed_batch])
 
     # Accuracy matching on a window (the tight reference is slow).
     n_match = int(args.match_seconds * RATE) + 1
