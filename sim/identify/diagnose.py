@@ -59,7 +59,7 @@ REFIT_EVALUATIONS = 15
 #: Further optimiser evaluations for an accepted effect, whose fit says how far the gap
 #: shrinks (the ranking needs only the short refits).
 POLISH_EVALUATIONS = 40
-#: Candidates tried on top of an accepted effect (the best by their own held-out score).
+#: Candidates tried on top of an accepted effect (the best by the score test on top of it).
 SECOND_STAGE = 3
 #: A runner-up is "indistinguishable" from the chosen effect unless the chosen one beats
 #: it on held-out cycles at this one-sided p-value.
@@ -220,9 +220,7 @@ def diagnose(
             )
         )
         started = time.perf_counter()
-        second, second_sims = _second_effect(
-            best, current, ranking, traces, nominal, x_base, probes, say
-        )
+        second, second_sims = _second_effect(best, current, pool, traces, nominal, x_base, say)
         sims += second_sims
         timings["second_effect"] = time.perf_counter() - started
         if second is not None:
@@ -307,22 +305,28 @@ def _indistinguishable(
 def _second_effect(
     first: str,
     current: _Fitted,
-    ranking: Sequence[RankedEffect],
+    pool: Sequence[str],
     traces: Sequence[Trace],
     nominal: StandParams,
     x_base: float,
-    probes: dict[str, dict[str, float]],
     say: Progress,
 ) -> tuple[tuple[AcceptedEffect, _Fitted] | None, int]:
-    """The best further effect on top of ``first``, if the held-out cycles say so."""
-    tries = [r.effect for r in ranking if r.effect != first and (r.score or 0.0) > 0.0]
+    """The best further effect on top of ``first``, if the held-out cycles say so.
+
+    The candidates tried are the best by a score test on top of ``first`` (screening
+    with its fit as the base, on the training cycles), not by their scores alone on the
+    baseline: an effect that the first one hides (a pulley's inertia behind a gauge
+    low-pass) explains nothing until the first is modelled.
+    """
+    others = [e for e in pool if e != first]
+    say(f"screening the other effects on top of {first}")
+    scores, probes, sims = screen(traces, nominal, current.result, current.outputs, others)
+    tries = [e for e in sorted(others, key=lambda e: -scores[e]) if scores[e] > 0.0]
     tries = tries[:SECOND_STAGE]
-    sims = 0
     best: tuple[str, _Fitted, Evidence] | None = None
     for effect in tries:
         say(f"refitting {effect} on top of {first}")
-        own = {k: v for k, v in probes.get(effect, {}).items() if k.startswith(f"{effect}.")}
-        probe = [{**current.result.values, **own}] if own else []
+        probe = [probes[effect]] if effect in probes else []
         fitted = _refit(
             Candidate.build(first, effect), traces, nominal, current.result.values, probe
         )

@@ -3,7 +3,8 @@
 Each effect's output change at a few probe magnitudes (its typical range), projected off
 the baseline parameters' directions; the share of the baseline's residual that direction
 explains orders the candidates and gives each refit one more start point. A few
-simulations per effect.
+simulations per effect. The same test on top of an accepted effect (its fit as the base)
+orders the candidates for a second one.
 """
 
 from __future__ import annotations
@@ -96,7 +97,8 @@ def screen(
     best_probe: dict[str, dict[str, float]] = {}
     sims = len(cols)
     for effect in effects:
-        cand = Candidate.build(effect)
+        # On top of the effects the base fit already has (none for the baseline).
+        cand = Candidate.build(*base_cand.effects, effect)
         best = 0.0
         for values in probe_values(effect, base_fit.values):
             d = _stack(traces, outputs_of(cand, values, traces, nominal)) - y_base
