@@ -30,6 +30,7 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent.parent
 RATE = 2000.0
+# Spelled out, not read from a registry: both trees (old and new) must run the same list.
 CASES = {
     "side_load_friction": ["side_load_friction"],
     "pulley_inertia_friction": ["pulley_inertia_friction"],
