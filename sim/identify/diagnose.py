@@ -220,7 +220,9 @@ def diagnose(
             )
         )
         started = time.perf_counter()
-        second, second_sims = _second_effect(best, current, pool, traces, nominal, x_base, say)
+        second, second_sims = _second_effect(
+            best, current, ranking, pool, traces, nominal, x_base, say
+        )
         sims += second_sims
         timings["second_effect"] = time.perf_counter() - started
         if second is not None:
@@ -305,6 +307,7 @@ def _indistinguishable(
 def _second_effect(
     first: str,
     current: _Fitted,
+    ranking: Sequence[RankedEffect],
     pool: Sequence[str],
     traces: Sequence[Trace],
     nominal: StandParams,
@@ -323,6 +326,8 @@ def _second_effect(
     scores, probes, sims = screen(traces, nominal, current.result, current.outputs, others)
     tries = [e for e in sorted(others, key=lambda e: -scores[e]) if scores[e] > 0.0]
     tries = tries[:SECOND_STAGE]
+    alone = [r.effect for r in ranking if r.effect != first and (r.score or 0.0) > 0.0]
+    tries += [e for e in alone[:SECOND_STAGE] if e not in tries]
     best: tuple[str, _Fitted, Evidence] | None = None
     for effect in tries:
         say(f"refitting {effect} on top of {first}")
