@@ -59,7 +59,8 @@ REFIT_EVALUATIONS = 15
 #: Further optimiser evaluations for an accepted effect, whose fit says how far the gap
 #: shrinks (the ranking needs only the short refits).
 POLISH_EVALUATIONS = 40
-#: Candidates tried on top of an accepted effect (the best by the score test on top of it).
+#: Candidates tried on top of an accepted effect: this many by the score test on top of it,
+#: and this many by their scores alone (see ``_second_effect``).
 SECOND_STAGE = 3
 #: A runner-up is "indistinguishable" from the chosen effect unless the chosen one beats
 #: it on held-out cycles at this one-sided p-value.
@@ -317,9 +318,11 @@ def _second_effect(
     """The best further effect on top of ``first``, if the held-out cycles say so.
 
     The candidates tried are the best by a score test on top of ``first`` (screening
-    with its fit as the base, on the training cycles), not by their scores alone on the
-    baseline: an effect that the first one hides (a pulley's inertia behind a gauge
-    low-pass) explains nothing until the first is modelled.
+    with its fit as the base, on the training cycles) — an effect that the first one
+    hides (a pulley's inertia behind a gauge low-pass) explains nothing alone until the
+    first is modelled — and the best by their held-out scores alone on the baseline (a
+    Maxwell branch that a force skew mimics in the score test). The best refit of them
+    is judged against ``first`` with a Bonferroni factor of their number.
     """
     others = [e for e in pool if e != first]
     say(f"screening the other effects on top of {first}")
