@@ -16,32 +16,21 @@ clock: on the simulated stand that clock is the host's, so nothing drifts).
 from __future__ import annotations
 
 import argparse
-import contextlib
-import io
 import json
 import os
 import re
-import resource
 import socket
 import subprocess
 import tempfile
-import threading
-import time
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+from bench_run import measured_run, run_args  # the same run, measured the same way
 
-from labstand.cli import main
 from recordings import open_recording
 
-FREQUENCY_HZ = 0.5
 CLIENT = Path(__file__).parent.parent / "tests" / "live" / "node" / "client.js"
-
-
-def cpu_s() -> float:
-    usage = resource.getrusage(resource.RUSAGE_SELF)
-    return usage.ru_utime + usage.ru_stime
 
 
 def free_port() -> int:
@@ -53,38 +42,12 @@ def free_port() -> int:
 
 def run(minutes: float, out: Path, port: int | None) -> tuple[float, float, str]:
     """One run; (steady CPU share, whole-command share, the live-view line)."""
-    cycles = max(1, round((minutes * 60 - 2.0) * FREQUENCY_HZ))
-    args = [
-        "run", "--backend", "sim", "--signal", "quasi-sinusoidal", "--amplitude-mm", "30",
-        "--frequency-hz", str(FREQUENCY_HZ), "--cycles", str(cycles),
-        "--dwell-start-s", "0.5", "--dwell-end-s", "1.5", "-o", str(out),
-    ]  # fmt: skip
+    args = run_args(minutes, out)
     if port is not None:
         args += ["--foxglove", str(port)]
-    samples: list[tuple[float, float]] = []
-    stop = threading.Event()
-
-    def sampler() -> None:
-        while not stop.wait(1.0):
-            samples.append((time.monotonic(), cpu_s()))
-
-    watcher = threading.Thread(target=sampler, daemon=True)
-    printed = io.StringIO()
-    wall0, cpu0 = time.monotonic(), cpu_s()
-    watcher.start()
-    try:
-        with contextlib.redirect_stdout(printed):
-            code = main(args)
-    finally:
-        stop.set()
-        watcher.join()
-    wall, cpu = time.monotonic() - wall0, cpu_s() - cpu0
-    if code != 0:
-        raise SystemExit(f"labstand run exited {code}:\n{printed.getvalue()}")
-    steady = [(t, c) for t, c in samples if wall0 + 10 < t < wall0 + wall - 5]
-    share = (steady[-1][1] - steady[0][1]) / (steady[-1][0] - steady[0][0])
-    live = next((ln for ln in printed.getvalue().splitlines() if "samples published" in ln), "")
-    return share, cpu / wall, live.strip()
+    measured = measured_run(args)
+    live = next((ln for ln in measured.printed.splitlines() if "samples published" in ln), "")
+    return measured.steady_share, measured.cpu_s / measured.wall_s, live.strip()
 
 
 def bench(minutes: float, folder: Path) -> None:

@@ -20,6 +20,7 @@ import resource
 import tempfile
 import threading
 import time
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -35,22 +36,36 @@ def cpu_s() -> float:
     return usage.ru_utime + usage.ru_stime
 
 
-def sampler(samples: list[tuple[float, float]], stop: threading.Event) -> None:
-    while not stop.wait(1.0):
-        samples.append((time.monotonic(), cpu_s()))
-
-
-def bench(minutes: float, fmt: str, folder: Path) -> None:
+def run_args(minutes: float, out: Path) -> list[str]:
+    """``labstand run`` on the simulated stand: 30 mm quasi-sinusoidal at 0.5 Hz."""
     cycles = max(1, round((minutes * 60 - 2.0) * FREQUENCY_HZ))
-    out = folder / f"bench-run.{fmt}"
-    args = [
+    return [
         "run", "--backend", "sim", "--signal", "quasi-sinusoidal", "--amplitude-mm", "30",
         "--frequency-hz", str(FREQUENCY_HZ), "--cycles", str(cycles),
         "--dwell-start-s", "0.5", "--dwell-end-s", "1.5", "-o", str(out),
     ]  # fmt: skip
+
+
+@dataclass(frozen=True)
+class MeasuredRun:
+    """What ``labstand run`` printed and the CPU it took in this process."""
+
+    printed: str
+    wall_s: float
+    cpu_s: float
+    steady_share: float  # of one core, from 10 s in to 5 s before the end
+
+
+def measured_run(args: list[str]) -> MeasuredRun:
+    """Run ``labstand ARGS`` in this process, sampling its CPU time every second."""
     samples: list[tuple[float, float]] = []
     stop = threading.Event()
-    watcher = threading.Thread(target=sampler, args=(samples, stop), daemon=True)
+
+    def sampler() -> None:
+        while not stop.wait(1.0):
+            samples.append((time.monotonic(), cpu_s()))
+
+    watcher = threading.Thread(target=sampler, daemon=True)
     printed = io.StringIO()
     wall0, cpu0 = time.monotonic(), cpu_s()
     watcher.start()
@@ -63,18 +78,24 @@ def bench(minutes: float, fmt: str, folder: Path) -> None:
     wall, cpu = time.monotonic() - wall0, cpu_s() - cpu0
     if code != 0:
         raise SystemExit(f"labstand run exited {code}:\n{printed.getvalue()}")
-    rec = open_recording(out)
-    g = rec.gauges
-    seq_ok = bool(np.all(np.diff(g["seq"]) == 1))
-    time_ok = bool(np.all(np.diff(g["t_ns"]) == 500_000))
-    # steady state: from 10 s in to 5 s before the end
     steady = [(t, c) for t, c in samples if wall0 + 10 < t < wall0 + wall - 5]
     share = (
         (steady[-1][1] - steady[0][1]) / (steady[-1][0] - steady[0][0]) if steady else cpu / wall
     )
+    return MeasuredRun(printed.getvalue(), wall, cpu, share)
+
+
+def bench(minutes: float, fmt: str, folder: Path) -> None:
+    out = folder / f"bench-run.{fmt}"
+    measured = measured_run(run_args(minutes, out))
+    wall, cpu, share = measured.wall_s, measured.cpu_s, measured.steady_share
+    rec = open_recording(out)
+    g = rec.gauges
+    seq_ok = bool(np.all(np.diff(g["seq"]) == 1))
+    time_ok = bool(np.all(np.diff(g["t_ns"]) == 500_000))
     polls = len(rec.drive) / rec.duration_s
     print(f"labstand run --backend sim, {minutes:g} min quasi-sinusoidal, {fmt}: {out}")
-    print(f"  {printed.getvalue().strip().splitlines()[-1]}")
+    print(f"  {measured.printed.strip().splitlines()[-1]}")
     print(f"  samples {len(g)} ({rec.duration_s:.1f} s), lost {rec.lost_samples}, "
           f"seq contiguous {seq_ok}, device time evenly spaced {time_ok}")  # fmt: skip
     print(f"  drive polls {len(rec.drive)} ({polls:.1f} Hz), events {len(rec.events())}")
