@@ -8,8 +8,6 @@ client that connects, subscribes and then never reads must cost the recording no
 from __future__ import annotations
 
 import socket
-import subprocess
-import sys
 from collections.abc import Callable
 from pathlib import Path
 
@@ -17,7 +15,7 @@ import numpy as np
 
 from recordings import open_recording
 from tests.live.conftest import NodeClient, read_url
-from tests.run.conftest import SHORT, Outcome, RunProcess
+from tests.run.conftest import SHORT, Outcome, RunProcess, labstand_process
 
 
 def _free_port() -> int:
@@ -121,25 +119,12 @@ def test_a_stalled_client_costs_the_recording_nothing(
     assert report["topics"]["/gauges"]["seq"] == rec.gauges["seq"].tolist()
 
 
-def _labstand(*args: str | Path) -> Outcome:
-    """``labstand ARGS`` as a process: the SDK's runtime (its threads, its epoll) lives
-    as long as the process that first started a server, so not in the test's."""
-    done = subprocess.run(
-        [sys.executable, "-m", "labstand", *map(str, args)],
-        capture_output=True,
-        text=True,
-        timeout=120,
-        check=False,
-    )
-    return Outcome(done.returncode, done.stdout, done.stderr)
-
-
 def test_busy_port_is_bad_input(tmp_path: Path) -> None:
     with socket.socket() as busy:
         busy.bind(("127.0.0.1", 0))
         busy.listen()
         port = busy.getsockname()[1]
-        result = _labstand("run", *SHORT, "-o", tmp_path / "r.mcap", "--foxglove", str(port))
+        result = labstand_process("run", *SHORT, "-o", tmp_path / "r.mcap", "--foxglove", str(port))
     assert result.code == 2
     assert result.last_error_line.startswith(f"labstand: error: --foxglove 127.0.0.1:{port}:")
     assert "in use" in result.last_error_line
@@ -149,7 +134,7 @@ def test_busy_port_is_bad_input(tmp_path: Path) -> None:
 
 def test_unreachable_address_is_bad_input(tmp_path: Path) -> None:
     # 192.0.2.1 (TEST-NET-1) is no address of this machine
-    result = _labstand("run", *SHORT, "-o", tmp_path / "r.mcap", "--foxglove", "192.0.2.1:0")
+    result = labstand_process("run", *SHORT, "-o", tmp_path / "r.mcap", "--foxglove", "192.0.2.1:0")
     assert result.code == 2
     assert "--foxglove 192.0.2.1:0:" in result.last_error_line
     assert "open to the network" in result.err  # the warning for a non-loopback address

@@ -22,7 +22,7 @@ from labstand.live.player import BLOCK_S, Player
 from recordings import RecordingMetadata, open_recording, open_writer
 from tests.live.conftest import NodeClient, read_url
 from tests.ptys import sigint_not_ignored
-from tests.run.conftest import Outcome
+from tests.run.conftest import Outcome, labstand_process
 
 
 class SimClock:
@@ -152,17 +152,6 @@ def test_play_serves_the_file_to_an_independent_client(
     assert topics["/events"]["count"] == len(rec.events_array)
 
 
-def _labstand(*args: str | Path) -> Outcome:
-    done = subprocess.run(
-        [sys.executable, "-m", "labstand", *map(str, args)],
-        capture_output=True,
-        text=True,
-        timeout=120,
-        check=False,
-    )
-    return Outcome(done.returncode, done.stdout, done.stderr)
-
-
 def test_a_recording_without_gauges_is_bad_input(
     tmp_path: Path, labstand: Callable[..., Outcome], meta: RecordingMetadata
 ) -> None:
@@ -187,7 +176,7 @@ def test_busy_port_is_bad_input(s11: Path) -> None:
         busy.bind(("127.0.0.1", 0))
         busy.listen()
         port = busy.getsockname()[1]
-        result = _labstand("play", s11, "--foxglove", str(port))
+        result = labstand_process("play", s11, "--foxglove", str(port))
     assert result.code == 2
     assert result.err.startswith(f"labstand: error: --foxglove 127.0.0.1:{port}:")
     assert len(result.err.splitlines()) == 1

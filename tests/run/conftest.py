@@ -47,6 +47,18 @@ class Outcome:
         return lines[-1] if lines else ""
 
 
+def labstand_process(*args: str | Path, timeout_s: float = 120.0) -> Outcome:
+    """Run ``python -m labstand ARGS`` as a child process (its own signals and stdio)."""
+    done = subprocess.run(
+        [sys.executable, "-m", "labstand", *map(str, args)],
+        capture_output=True,
+        text=True,
+        timeout=timeout_s,
+        check=False,
+    )
+    return Outcome(done.returncode, done.stdout, done.stderr)
+
+
 @pytest.fixture
 def labstand(capsys: pytest.CaptureFixture[str]) -> Callable[..., Outcome]:
     """Run ``labstand ARGS`` in this process."""
