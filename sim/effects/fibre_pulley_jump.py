@@ -32,8 +32,9 @@ def _start_state(
 INFO = EffectInfo(
     "fibre_pulley_jump", "physical",
     "once the slack is onset_m deep and has lasted dwell_s the fibre leaves its groove and "
-    "re-seats in the other of two seats, changing the effective length by "
-    "step_m·(1 − exp(−(slack depth − onset_m)/depth_scale_m))",
+    "re-seats in the next seat (the other of two grooves, or one step up the flank, up to "
+    "seats steps), changing the effective length by "
+    "step_m·(1 − exp(−(slack depth − onset_m)/depth_scale_m)) per step",
     "offset steps in force and position right after slack episodes",
     ek.R_PJ_ON,
     (
@@ -59,6 +60,13 @@ INFO = EffectInfo(
               # 0, then 2 ms to 0.2 s in steps of 20 %: finer than the spread of the
               # slack episodes' lengths (tens of ms) the threshold must fall between.
               scan=(0.0, *(float(v) for v in np.geomspace(2.0e-3, 0.2, 26)))),
+        param("seats", "1", 0.0, (0.0, 0.0), (0.0, 20.0), ek.R_PJ_SEATS,
+              "0: the fibre toggles between two grooves; n ≥ 1: each episode moves it one "
+              "step_m further up the groove's flank, up to n steps (the flange), where it "
+              "stays", drawn=False, bounds=(0.0, 8.0), integer=True, scan=tuple(range(9)),
+              why="a pulley with two grooves (or a groove and its flange) toggles; a single "
+                  "groove 1–2 mm deep lets a fibre climb its flank in a few steps of "
+                  "0.1–2 mm before the flange stops it"),
     ),
     start_state=_start_state,
 )

@@ -96,6 +96,8 @@ class ParamInfo:
     #: move it. Fitted by scanning (``scan`` levels, refined between the best's
     #: neighbours), held fixed in the local fits. Empty: fitted by gradient.
     scan: tuple[float, ...] = ()
+    #: A count (a scanned threshold taking whole values only): scanned at ``scan`` alone.
+    integer: bool = False
 
     @property
     def fit_low(self) -> float:
@@ -196,8 +198,8 @@ def param(name: str, unit: str, default: float, plausible: tuple[float, float],
           admissible: tuple[float, float], column: int, description: str, *,
           fit: bool = True, log: bool = False, drawn: bool | None = None,
           bounds: tuple[float, float] = (0.0, 0.0), why: str = "",
-          scan: tuple[float, ...] = ()) -> ParamInfo:
+          scan: tuple[float, ...] = (), integer: bool = False) -> ParamInfo:
     """A ParamInfo from the typical (``plausible``) and admissible ranges as pairs."""
     return ParamInfo(name, unit, default, *plausible, *admissible, description, column, fit, log,
-                     drawn, bounds, why, scan)
+                     drawn, bounds, why, scan, integer)
 # fmt: on

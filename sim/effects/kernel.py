@@ -51,10 +51,12 @@ from numba import njit, prange
 (R_FG_ON, R_FG_FC, R_FG_ZETA) = range(44, 47)
 R_PJ_ONSET = 47  # appended (the pulley jump's third and fourth parameters came last)
 R_PJ_DWELL = 48
+R_PJ_SEATS = 49
+R_SS_EXP = 50
 # Effects added outside this file (``sim.effects.registry.register``): R_X_ON is 1.0 when
 # any is on; each has a flag and its parameters in the N_X columns from R_X.
-R_X_ON = 49
-R_X = 50
+R_X_ON = 51
+R_X = 52
 N_X = 8
 N_ROW = R_X + N_X
 # Derived constants, then the discrete state, then the friction table: indices into c.
@@ -258,6 +260,15 @@ def _added_force(c, y, t2):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True, error_model="numpy")
+def _stribeck(v, c):  # type: ignore[no-untyped-def]
+    """The Stribeck curve's shape exp(−|v/v_s|^δ): 1 at rest, 0 when sliding fast."""
+    r = abs(v) / c[R_SS_VS]
+    if c[R_SS_EXP] == 2.0:  # the Gaussian (the default): no power function per step
+        return math.exp(-r * r)
+    return math.exp(-(r ** c[R_SS_EXP]))
+
+
+@njit(cache=True, error_model="numpy")
 def _rhs(c, y, xa, xd):  # type: ignore[no-untyped-def]
     """dy/dt at drive position xa (rate xd) in the current regimes."""
     sg = _segments(c, y, xa, 0.0, xd)
@@ -266,10 +277,10 @@ def _rhs(c, y, xa, xd):  # type: ignore[no-untyped-def]
     zone = int(c[S_ZONE])
     zd = 0.0
     if c[D_SS_ON] > 0.0:  # LuGre replaces the table's friction
-        r = v / c[R_SS_VS]
-        g = c[P_FRICTION_N] * _mu(abs(v), c) * (1.0 + c[R_SS_RATIO] * math.exp(-r * r))
+        shape = _stribeck(v, c)
+        g = c[P_FRICTION_N] * _mu(abs(v), c) * (1.0 + c[R_SS_RATIO] * shape)
         zd = v - c[D_SIG0] * abs(v) * y[Y_Z] / g
-        fric = c[D_SIG0] * y[Y_Z] + c[D_SIG1] * math.exp(-r * r) * zd
+        fric = c[D_SIG0] * y[Y_Z] + c[D_SIG1] * shape * zd
     else:
         fric = _friction(v, zone, c)
     if c[R_SL_ON] > 0.0:
@@ -408,17 +419,23 @@ def _reseat(c, slack, elongation, h):  # type: ignore[no-untyped-def]
 
     The fibre leaves its groove once its loop is ``onset`` deep and has lain slack for
     ``dwell`` (held by groove friction, it needs time to slide out), and has moved over to
-    the other seat within a few depth scales more. The seat follows the episode's deepest
-    geometric slack, so it never moves back within one episode; when the fibre is taut
-    again it stays where it is. The same law runs on the model's slack (``_after_part``)
-    and on the recorded one (``measured_seats``).
+    the next seat within a few depth scales more: with ``seats`` = 0 the other of two
+    grooves (it toggles), else one more step up the groove's flank, up to ``seats`` steps
+    (the flange), where it stays. The seat follows the episode's deepest geometric slack,
+    so it never moves back within one episode; when the fibre is taut again it stays where
+    it is. The same law runs on the model's slack (``_after_part``) and on the recorded
+    one (``measured_seats``).
     """
     if slack:
         c[S_SLACKT] += h
         c[S_DEPTH] = max(c[S_DEPTH], -(elongation + c[S_LBASE]))
         if c[S_SLACKT] >= c[R_PJ_DWELL]:
             base, step = c[S_LBASE], c[R_PJ_STEP]
-            target = step if abs(base) <= abs(base - step) else 0.0  # the other seat
+            seats = math.floor(c[R_PJ_SEATS] + 0.5)
+            if seats < 1 or step == 0.0:
+                target = step if abs(base) <= abs(base - step) else 0.0  # the other seat
+            else:  # one step further up the flank, at most ``seats`` steps
+                target = min(math.floor(base / step + 0.5) + 1.0, seats) * step
             beyond = max(0.0, c[S_DEPTH] - c[R_PJ_ONSET])
             c[S_LOFF] = base + (target - base) * (1.0 - math.exp(-beyond / c[R_PJ_DEPTH]))
     elif c[S_SLACKT] > 0.0:  # the episode is over: the fibre stays in its new seat
@@ -637,8 +654,7 @@ def measured_state(c, x, xd, m):  # type: ignore[no-untyped-def]
         a1, a2 = c[D_AR1] * scale, c[D_AR2] * scale
     z = 0.0
     if c[D_SS_ON] > 0.0:
-        r = v / c[R_SS_VS]
-        g = c[P_FRICTION_N] * _mu(abs(v), c) * (1.0 + c[R_SS_RATIO] * math.exp(-r * r))
+        g = c[P_FRICTION_N] * _mu(abs(v), c) * (1.0 + c[R_SS_RATIO] * _stribeck(v, c))
         limit = g / c[D_SIG0]
         if abs(v) > c[R_SS_VS]:
             z = limit if v > 0.0 else -limit

@@ -13,7 +13,7 @@ from sim.effects.info import EffectInfo, param
 INFO = EffectInfo(
     "stick_slip_friction", "physical",
     "LuGre friction: bristle state z, ż = v − σ₀|v|z/g(v), F = σ₀z + σ₁ż with "
-    "g(v) = table friction·(1 + r·exp(−(v/v_s)²)); needs the stand's friction table",
+    "g(v) = table friction·(1 + r·exp(−|v/v_s|^δ)); needs the stand's friction table",
     "residual at velocity reversals and at low speed, visible in slow tests",
     ek.R_SS_ON,
     (
@@ -25,6 +25,11 @@ INFO = EffectInfo(
               "v_s: speed over which friction falls to kinetic", log=True,
               bounds=(1.0e-4, 0.1),
               why="lubricated line contacts show Stribeck speeds from 0.1 mm/s to 0.1 m/s"),
+        param("stribeck_exponent", "1", 2.0, (2.0, 2.0), (0.1, 10.0), ek.R_SS_EXP,
+              "δ: how the friction falls from static to kinetic, exp(−|v/v_s|^δ)",
+              drawn=False, bounds=(0.5, 3.0),
+              why="measured Stribeck curves fall exponentially (δ ≈ 0.5–1) to like a "
+                  "Gaussian (δ = 2) or steeper, with the lubricant and the surfaces"),
         param("bristle_stiffness_n_m", "N/m", 1.0e5, (3.0e4, 3.0e5), (1.0e3, 1.0e7),
               ek.R_SS_SIGMA, "σ₀, presliding stiffness (σ₁ = 2√(σ₀m))", fit=False, log=True),
     ),

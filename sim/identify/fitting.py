@@ -57,6 +57,8 @@ class FreeParam:
     typical: tuple[float, float] | None = None
     #: Levels (natural units) of a threshold fitted by scanning, held in local fits.
     scan: tuple[float, ...] = ()
+    #: A count: scanned at its levels only, not between them.
+    integer: bool = False
 
     def to_internal(self, value: float) -> float:
         """Natural value → optimiser coordinate."""
@@ -72,6 +74,8 @@ class FreeParam:
 
     def to_natural(self, z: float) -> float:
         """Optimiser coordinate → natural value."""
+        if self.integer:
+            return float(round(z))
         if self.scale == "log":
             return float(np.exp(z))
         if self.scale == "asinh":
@@ -79,7 +83,12 @@ class FreeParam:
         return z
 
     def at_bound(self, value: float, share: float = 2e-3) -> bool:
-        """Whether a fitted value ended on a bound (within ``share`` of the range)."""
+        """Whether a fitted value ended on a bound (within ``share`` of the range).
+
+        A count's lowest level is a form of the effect, not a limit: only its highest is.
+        """
+        if self.integer:
+            return value >= self.scan[-1] - 0.5
         lo, hi = self.bounds()
         z = self.to_internal(value)
         return bool(z <= lo + share * (hi - lo) or z >= hi - share * (hi - lo))
@@ -87,13 +96,13 @@ class FreeParam:
 
 def _free(effect: str, p: ParamInfo) -> FreeParam:
     """An effect parameter as fitted: within its physical range (``ParamInfo.bounds``)."""
-    low, high, typical = p.fit_low, p.fit_high, (p.low, p.high)
+    low, high, typical, name = p.fit_low, p.fit_high, (p.low, p.high), f"{effect}.{p.name}"
     if p.log and low > 0:
-        return FreeParam(f"{effect}.{p.name}", low, high, "log", typical=typical, scan=p.scan)
+        return FreeParam(name, low, high, "log", typical=typical, scan=p.scan, integer=p.integer)
     if p.log:  # signed, spanning decades
         width = max(abs(p.low), abs(p.high)) / 4
-        return FreeParam(f"{effect}.{p.name}", low, high, "asinh", width, typical, p.scan)
-    return FreeParam(f"{effect}.{p.name}", low, high, typical=typical, scan=p.scan)
+        return FreeParam(name, low, high, "asinh", width, typical, p.scan, p.integer)
+    return FreeParam(name, low, high, typical=typical, scan=p.scan, integer=p.integer)
 
 
 @dataclass
@@ -284,11 +293,14 @@ EFFECT_GRID_LEVELS = {1: 8, 2: 5, 3: 2}
 def _grid_axis(p: FreeParam, levels: int) -> FloatArray:
     """Start-grid levels of one parameter (optimiser coordinates): dense where typical."""
     lo, hi = p.bounds()
+    if p.integer:  # a count: its first level; the scan after the local fit finds the rest
+        return np.array([p.to_internal(p.scan[0])])
     if p.typical is None:
         return np.linspace(lo, hi, levels + 2)[1:-1]
     t_lo = float(np.clip(p.to_internal(max(p.typical[0], p.low)), lo, hi))
     t_hi = float(np.clip(p.to_internal(min(p.typical[1], p.high)), lo, hi))
-    axis = list(np.linspace(t_lo, t_hi, levels + 2)[1:-1])
+    # One level where the typical range is a single value (a form's usual exponent).
+    axis = list(np.linspace(t_lo, t_hi, levels + 2)[1:-1]) if t_hi > t_lo else [t_lo]
     edge = 1e-6 * (hi - lo)
     if t_lo - lo > edge:
         axis.append(0.5 * (lo + t_lo))
@@ -406,9 +418,9 @@ def scan_thresholds(
 ) -> tuple[dict[str, float], float, int]:
     """Each threshold parameter scanned at the others' values: (values, cost, simulations).
 
-    One batch over its levels, then one between the best level's neighbours (9 points):
-    the cost is a step function of a threshold, flat between the recorded episodes it
-    separates, so only a scan finds the step that matters.
+    One batch over its levels, then one between the best level's neighbours (9 points; a
+    count: its levels only): the cost is a step function of a threshold, flat between
+    the recorded episodes it separates, so only a scan finds the step that matters.
     """
     objective = Objective(candidate, traces, nominal, stride)
     z = np.array([p.to_internal(values[p.name]) for p in candidate.params])
@@ -417,7 +429,7 @@ def scan_thresholds(
         if not p.scan:
             continue
         levels = np.array([p.to_internal(float(np.clip(v, p.low, p.high))) for v in p.scan])
-        for _ in range(2):
+        for _ in range(1 if p.integer else 2):
             zs = np.repeat(z[None, :], levels.size, axis=0)
             zs[:, i] = levels
             costs = np.sum(objective.residuals_batch(zs) ** 2, axis=1)

@@ -190,6 +190,38 @@ def test_pulley_jump_changes_the_fibre_length_only_across_slack_episodes(
     assert np.array_equal(slow_run.u_m, slow_base.u_m)
 
 
+def _seat_levels(stand: StandConfig, spec: EffectSpec) -> list[float]:
+    """The effective length offset L of each taut phase of situation 11 (slack each cycle)."""
+    x, mass = situation_drive(stand, "11")
+    p, _, run = _pair(stand, x, mass, spec)
+    rel = x - x[0]
+    xd = np.concatenate([[0.0], np.diff(rel) * RATE])
+    n = p.projection
+    length = (run.force_n - p.damping_n_s_m * (xd - n * run.v_m_s)) / p.stiffness_n_m
+    length -= p.preload_m + rel - n * run.u_m
+    taut = run.force_n > 0
+    phase = np.cumsum(np.diff(taut.astype(int), prepend=1) == 1)
+    return [float(length[taut & (phase == k)].mean()) for k in np.unique(phase[taut])]
+
+
+def test_a_fibre_climbing_the_flank_steps_up_to_the_flange_and_stays(
+    stand: StandConfig,
+) -> None:
+    # A snap jump (depth scale ≪ the slack loops): every episode moves the seat by a
+    # whole step. Two grooves toggle between 0 and the step; a flank of two steps climbs
+    # 0 → step → 2·step and stays at the flange.
+    step = 3e-4
+    snap = {"step_m": step, "depth_scale_m": 1e-6}
+    toggle = np.array(_seat_levels(stand, EffectSpec("fibre_pulley_jump", snap)))
+    flank = np.array(
+        _seat_levels(stand, EffectSpec("fibre_pulley_jump", {**snap, "seats": 2.0}))
+    )
+    assert toggle.size > 4 and flank.size > 4
+    assert np.allclose(toggle[:4], [0.0, step, 0.0, step], atol=2e-6)
+    assert np.allclose(flank[:3], [0.0, step, 2 * step], atol=2e-6)
+    assert np.allclose(flank[3:], 2 * step, atol=2e-6)  # never past the flange, never back
+
+
 def test_the_fibre_stays_in_its_groove_until_the_slack_reaches_the_onset(
     stand: StandConfig,
 ) -> None:
@@ -355,6 +387,38 @@ def test_stick_slip_shows_at_low_speed_not_in_fast_sliding(stand: StandConfig) -
             assert run.force_n[late].mean() == pytest.approx(base.force_n[late].mean(), rel=2e-3)
     slow_run, slow_base = spreads[0.002]
     assert slow_run > 0.3 > 10 * slow_base  # sticking and slipping: the force saws
+
+
+@pytest.mark.parametrize("exponent", [0.5, 1.0])
+def test_sliding_friction_follows_the_stribeck_curve(stand: StandConfig, exponent: float) -> None:
+    # Newton on the weight gives its friction from the recorded channels, sample by sample:
+    # f = n·F − m·g·sin α − m·a. Sliding (bristles settled within milliseconds), LuGre's
+    # friction is its Stribeck curve g(v) = f_table(v)·(1 + r·e^(−|v/v_s|^δ)). (The
+    # Gaussian, δ = 2, falls so steeply that the weight slides in stick-slip bursts here,
+    # its bristles never settled: the curves that fall gently are the ones to read.)
+    p = stand.stand_params("final", HEAVY)
+    n, m = p.projection, p.mass_kg
+    t = np.arange(int(2.0 * RATE)) / RATE
+    x = 0.5 * 0.1 * t**2  # the drive accelerates: the weight sweeps the curve's speeds
+    ratio, v_s = 0.8, 0.04
+    params = {"static_ratio": ratio, "stribeck_speed_m_s": v_s, "stribeck_exponent": exponent}
+    shares = []
+    for run in (
+        Model(p).run(x, RATE),
+        Model(p, [EffectSpec("stick_slip_friction", params)]).run(x, RATE),
+    ):
+        v = run.v_m_s
+        friction = n * run.force_n - p.gravity_along_n - m * np.gradient(v, 1.0 / RATE)
+        table = p.friction.force_n(v, p.normal_force_n) * p.friction_scale  # type: ignore[union-attr]
+        sliding = (v > 0.5 * v_s) & (v < 4 * v_s) & (t > 0.5)  # after the breakaway
+        assert sliding.sum() > 200
+        shares.append((friction[sliding] / table[sliding] - 1.0, v[sliding]))
+    (base_excess, _), (excess, v) = shares
+    assert np.abs(base_excess).max() < 0.02  # the plain table
+    expected = ratio * np.exp(-((v / v_s) ** exponent))
+    error = np.abs(excess - expected) / ratio
+    assert np.median(error) < 0.01
+    assert np.percentile(error, 95) < 0.03
 
 
 def test_stick_slip_residual_starts_at_the_drive_reversals_of_a_slow_test(

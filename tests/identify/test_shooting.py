@@ -291,6 +291,7 @@ def test_a_threshold_is_found_by_scanning_and_held_in_the_local_fit(stand: Stand
     candidate = Candidate.build(effect)
     start = dict(BASE, **{f"{effect}.{k}": v for k, v in truth.items()})
     start[f"{effect}.onset_m"] = 0.0
+    start[f"{effect}.seats"] = 0.0  # the truth's form: two grooves
     start[f"{effect}.dwell_s"] = 0.1  # longer than every episode: the seat never moves
     local = fit(candidate, [tr], nominal, baseline=start, single_start=True, max_nfev=5)
     assert local.values[f"{effect}.dwell_s"] == pytest.approx(0.1, rel=1e-9)
