@@ -200,14 +200,8 @@ def diagnose(
     accepted: list[AcceptedEffect] = []
     after_out = base_out
     confidence = 0.0
-    # The best held-out closure among the candidates whose evidence holds. Bonferroni
-    # bounds the chance that *any* of the tested candidates passes by luck, so a
-    # candidate may be named although a better-closing one is not: a light string-mode
-    # and stick-slip campaign's stick-slip refit closed 0.18 at p 0.0093 (× 9: fails),
-    # its string modes 0.14 at p 0.00096 — only the first was ever tested, and the
-    # answer was `none`.
-    passing = [r.effect for r in ranking if evidence[r.effect].accepted(len(refits))]
-    best = passing[0] if passing else (ranking[0].effect if ranking else None)
+    chosen = strongest_accepted(ranking, evidence, len(refits))
+    best = chosen or (ranking[0].effect if ranking else None)
     if best is not None:
         confidence = bootstrap_confidence(
             cycle_improvements(traces, base_out, refits[best].outputs)
@@ -264,6 +258,23 @@ def diagnose(
         outputs_before=base_out,
         outputs_after=after_out,
     )
+
+
+def strongest_accepted(
+    ranking: Sequence[RankedEffect], evidence: dict[str, Evidence], tests: int
+) -> str | None:
+    """The best held-out closure among the candidates whose evidence holds, or None.
+
+    Bonferroni bounds the chance that *any* of the ``tests`` candidates passes by luck,
+    so a candidate may be named although a better-closing one is not: on a light
+    string-mode and stick-slip campaign the stick-slip refit closed 0.18 at p 0.0093
+    (× 9: fails), the string modes 0.14 at p 0.00096; only the first was tested, and the
+    answer was ``none``.
+    """
+    for line in ranking:  # best closure first
+        if line.effect in evidence and evidence[line.effect].accepted(tests):
+            return line.effect
+    return None
 
 
 def _ranking(

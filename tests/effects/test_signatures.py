@@ -213,9 +213,7 @@ def test_a_fibre_climbing_the_flank_steps_up_to_the_flange_and_stays(
     step = 3e-4
     snap = {"step_m": step, "depth_scale_m": 1e-6}
     toggle = np.array(_seat_levels(stand, EffectSpec("fibre_pulley_jump", snap)))
-    flank = np.array(
-        _seat_levels(stand, EffectSpec("fibre_pulley_jump", {**snap, "seats": 2.0}))
-    )
+    flank = np.array(_seat_levels(stand, EffectSpec("fibre_pulley_jump", {**snap, "seats": 2.0})))
     assert toggle.size > 4 and flank.size > 4
     assert np.allclose(toggle[:4], [0.0, step, 0.0, step], atol=2e-6)
     assert np.allclose(flank[:3], [0.0, step, 2 * step], atol=2e-6)

@@ -11,8 +11,10 @@ from sim.effects import EffectSpec
 from sim.effects.realism import MeasurementNoise, NoiseSpec, draw_real_stand
 from sim.identify import diagnose, make_trace
 from sim.identify.check import DRIVE_NOISE_M, SMALL_CAMPAIGN
-from sim.identify.decide import p_value_of_gains
+from sim.identify.decide import Evidence, p_value_of_gains
+from sim.identify.diagnose import strongest_accepted
 from sim.identify.fitting import FreeParam
+from sim.identify.report import RankedEffect
 from sim.identify.traces import Trace
 from sim.model import Model
 
@@ -127,3 +129,21 @@ def test_a_trace_no_model_explains_does_not_drown_a_consistent_gain(
     assert evidence.accepted(9), evidence
     alone = compare(traces[3:], before[3:], after[3:])
     assert not alone.accepted(9), alone
+
+
+def test_the_best_closure_whose_evidence_holds_is_named_not_only_the_best_closure() -> None:
+    # Bonferroni bounds the chance that any of the tested candidates passes by luck, so a
+    # candidate that passes is named even when one that closes more does not.
+    ranking = [RankedEffect("a", screening=0.3), RankedEffect("b", screening=0.1)]
+    ranking[0].score, ranking[1].score = 0.18, 0.14  # a closes more
+    tests = 9
+    weak_a = Evidence(x_before=12.7, x_after=10.6, p_value=0.0093, blocks=34)  # × 9 > 0.05
+    strong_b = Evidence(x_before=12.7, x_after=11.0, p_value=0.00096, blocks=34)
+    assert strongest_accepted(ranking, {"a": weak_a, "b": strong_b}, tests) == "b"
+    strong_a = Evidence(x_before=12.7, x_after=10.6, p_value=0.0005, blocks=34)
+    assert strongest_accepted(ranking, {"a": strong_a, "b": strong_b}, tests) == "a"
+    weak_b = Evidence(x_before=12.7, x_after=11.0, p_value=0.02, blocks=34)
+    assert strongest_accepted(ranking, {"a": weak_a, "b": weak_b}, tests) is None
+    # A consistent gain below X's resolution (a tenth of X) is not evidence either.
+    tiny_b = Evidence(x_before=12.7, x_after=12.6, p_value=1e-6, blocks=34)
+    assert strongest_accepted(ranking, {"a": weak_a, "b": tiny_b}, tests) is None
