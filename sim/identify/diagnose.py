@@ -29,7 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from sim.effects import EFFECTS
-from sim.identify.decide import Evidence, compare
+from sim.identify.decide import Evidence, compare, judge
 from sim.identify.fitting import (
     Candidate,
     FitResult,
@@ -194,7 +194,7 @@ def diagnose(
             base_values, base_out, x_base = values, outs, excess
     timings["baseline_check"] = time.perf_counter() - started
 
-    evidence = {e: compare(traces, base_out, f.outputs) for e, f in refits.items()}
+    evidence = judge(traces, base_out, {e: f.outputs for e, f in refits.items()})
     ranking = _ranking(order, scores, refits, evidence, x_base, traces)
 
     accepted: list[AcceptedEffect] = []
@@ -216,7 +216,7 @@ def diagnose(
             AcceptedEffect(
                 best,
                 _closure(x_base, current.excess, x_base),
-                min(1.0, evidence[best].p_value * len(refits)),
+                evidence[best].corrected_p(len(refits)),
                 _effect_params(best, current.result.values),
                 _at_bound(current.result, best),
                 _indistinguishable(best, refits, evidence, traces, len(refits)),
@@ -350,27 +350,28 @@ def _second_effect(
     tries = tries[:SECOND_STAGE]
     alone = [r.effect for r in ranking if r.effect != first and (r.score or 0.0) > 0.0]
     tries += [e for e in alone[:SECOND_STAGE] if e not in tries]
-    best: tuple[str, _Fitted, Evidence] | None = None
+    fits: dict[str, _Fitted] = {}
     for effect in tries:
         say(f"refitting {effect} on top of {first}")
         probe = [probes[effect]] if effect in probes else []
-        fitted = _refit(
+        fits[effect] = _refit(
             Candidate.build(first, effect), traces, nominal, current.result.values, probe
         )
-        sims += fitted.result.evaluations
-        ev = compare(traces, current.outputs, fitted.outputs)
-        # The best held-out error among those whose evidence holds (as for the first).
-        if ev.accepted(len(tries)) and (best is None or fitted.excess < best[1].excess):
-            best = (effect, fitted, ev)
-    if best is None:
+        sims += fits[effect].result.evaluations
+    evidence = judge(traces, current.outputs, {e: f.outputs for e, f in fits.items()})
+    # The best held-out error among those whose evidence holds (as for the first).
+    passing = [e for e in tries if evidence[e].accepted(len(tries))]
+    if not passing:
         return None, sims
+    best_effect = min(passing, key=lambda e: fits[e].excess)
+    best = (best_effect, fits[best_effect], evidence[best_effect])
     effect, fitted, ev = best
     fitted = _polish(fitted, traces, nominal)
     sims += fitted.result.evaluations
     line = AcceptedEffect(
         effect,
         _closure(current.excess, fitted.excess, x_base),
-        min(1.0, ev.p_value * len(tries)),
+        ev.corrected_p(len(tries)),
         _effect_params(effect, fitted.result.values),
         _at_bound(fitted.result, effect),
     )

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
@@ -11,7 +13,7 @@ from sim.effects import EffectSpec
 from sim.effects.realism import MeasurementNoise, NoiseSpec, draw_real_stand
 from sim.identify import diagnose, make_trace
 from sim.identify.check import DRIVE_NOISE_M, SMALL_CAMPAIGN
-from sim.identify.decide import Evidence, p_value_of_gains
+from sim.identify.decide import Evidence, family_p_values, p_value_of_gains
 from sim.identify.diagnose import strongest_accepted
 from sim.identify.fitting import FreeParam
 from sim.identify.report import RankedEffect
@@ -147,3 +149,30 @@ def test_the_best_closure_whose_evidence_holds_is_named_not_only_the_best_closur
     # A consistent gain below X's resolution (a tenth of X) is not evidence either.
     tiny_b = Evidence(x_before=12.7, x_after=12.6, p_value=1e-6, blocks=34)
     assert strongest_accepted(ranking, {"a": weak_a, "b": tiny_b}, tests) is None
+
+
+def test_the_family_of_candidates_keeps_its_false_alarm_rate_and_counts_alike_ones_once() -> None:
+    rng = np.random.default_rng(3)
+    blocks, candidates = 34, 9
+    # "No effect": each block's gains are symmetric about zero for all candidates at
+    # once, and correlated between them (every refit also moves the baseline's
+    # parameters). The smallest family p-value falls below α at most α of the time.
+    smallest = []
+    for _ in range(200):
+        shared = rng.normal(0.0, 1.0, blocks)
+        gains = 0.8 * shared + 0.6 * rng.normal(0.0, 1.0, (candidates, blocks))
+        smallest.append(family_p_values(gains, flips=2000, seed=int(rng.integers(1 << 30))).min())
+    false_alarms = np.mean(np.array(smallest) <= 0.05)
+    assert false_alarms <= 0.05 + 2 * math.sqrt(0.05 * 0.95 / 200)
+    # Nine copies of one candidate are one test, not nine: the family p-value is the
+    # single test's, where Bonferroni's would be nine times it.
+    one = np.abs(rng.normal(0.0, 1.0, blocks)) * np.where(np.arange(blocks) % 5 == 0, -1, 1)
+    single = p_value_of_gains(one)
+    family = family_p_values(np.tile(one, (candidates, 1)))
+    assert np.allclose(family, family[0])
+    assert family[0] == pytest.approx(single, rel=0.5)
+    assert family[0] < 0.2 * candidates * single
+    # Independent candidates are nine tests: about Bonferroni's (Šidák's) correction.
+    independent = rng.normal(0.0, 1.0, (candidates, blocks))
+    independent[0] = one
+    assert family_p_values(independent)[0] > 0.5 * candidates * single
