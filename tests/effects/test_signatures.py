@@ -158,6 +158,18 @@ def test_string_ripple_follows_snatches_and_spares_displacement(stand: StandConf
     assert np.abs(slow_run.force_n - slow_base.force_n).max() < 0.01
 
 
+def _length_offset(p: StandParams, x: np.ndarray, run: ModelRun) -> np.ndarray:
+    """Effective length offset L, reconstructed from the recorded channels (taut samples).
+
+    F = k·(δ₀ + x − n·u + L) + c·(ẋ − n·v), with ẋ the sample interval's rate.
+    """
+    rel = x - x[0]
+    xd = np.concatenate([[0.0], np.diff(rel) * RATE])
+    n = p.projection
+    length = (run.force_n - p.damping_n_s_m * (xd - n * run.v_m_s)) / p.stiffness_n_m
+    return np.asarray(length - (p.preload_m + rel - n * run.u_m))
+
+
 @pytest.mark.parametrize("params", ["starting", "final"])
 def test_pulley_jump_changes_the_fibre_length_only_across_slack_episodes(
     stand: StandConfig, params: str
@@ -165,13 +177,7 @@ def test_pulley_jump_changes_the_fibre_length_only_across_slack_episodes(
     x, mass = situation_drive(stand, "11")
     spec = EffectSpec("fibre_pulley_jump")
     p, base, run = _pair(stand, x, mass, spec, params)
-    # Effective length offset L, reconstructed from the recorded channels at taut samples:
-    # F = k·(δ₀ + x − n·u + L) + c·(ẋ − n·v), with ẋ the sample interval's rate.
-    rel = x - x[0]
-    xd = np.concatenate([[0.0], np.diff(rel) * RATE])
-    n = p.projection
-    length = (run.force_n - p.damping_n_s_m * (xd - n * run.v_m_s)) / p.stiffness_n_m
-    length -= p.preload_m + rel - n * run.u_m
+    length = _length_offset(p, x, run)
     taut = run.force_n > 0
     first = int(np.argmax(~taut))
     assert np.array_equal(run.u_m[:first], base.u_m[:first])  # identical until the first slack
@@ -194,11 +200,7 @@ def _seat_levels(stand: StandConfig, spec: EffectSpec) -> list[float]:
     """The effective length offset L of each taut phase of situation 11 (slack each cycle)."""
     x, mass = situation_drive(stand, "11")
     p, _, run = _pair(stand, x, mass, spec)
-    rel = x - x[0]
-    xd = np.concatenate([[0.0], np.diff(rel) * RATE])
-    n = p.projection
-    length = (run.force_n - p.damping_n_s_m * (xd - n * run.v_m_s)) / p.stiffness_n_m
-    length -= p.preload_m + rel - n * run.u_m
+    length = _length_offset(p, x, run)
     taut = run.force_n > 0
     phase = np.cumsum(np.diff(taut.astype(int), prepend=1) == 1)
     return [float(length[taut & (phase == k)].mean()) for k in np.unique(phase[taut])]
