@@ -27,7 +27,6 @@ for closing 0.3 % of the gap (the demo's Maxwell branch, then string modes at p 
 
 from __future__ import annotations
 
-import dataclasses
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -149,13 +148,20 @@ def judge(
     p = 0.0086).
     """
     names = list(candidates)
-    evidence = {n: compare(traces, before, candidates[n]) for n in names}
     if not names:
-        return evidence
+        return {}
+    x_before = heldout_excess(traces, before)
     gains = np.stack([block_gains(traces, before, candidates[n]) for n in names])
-    for name, p in zip(names, family_p_values(gains, flips), strict=True):
-        evidence[name] = dataclasses.replace(evidence[name], p_family=float(p))
-    return evidence
+    return {
+        name: Evidence(
+            x_before=x_before,
+            x_after=heldout_excess(traces, candidates[name]),
+            p_value=p_value_of_gains(g),
+            blocks=int(g.size),
+            p_family=float(p),
+        )
+        for name, g, p in zip(names, gains, family_p_values(gains, flips), strict=True)
+    }
 
 
 def family_p_values(gains: np.ndarray, flips: int = FLIPS, seed: int = 0) -> np.ndarray:
