@@ -295,6 +295,7 @@ def _ranking(
             line.heldout_error = heldout_error(traces, fitted.outputs)
             line.heldout_excess = fitted.excess
             line.p_value = evidence[effect].p_value
+            line.p_family = evidence[effect].p_family
             line.params = _effect_params(effect, fitted.result.values)
             line.at_bound = _at_bound(fitted.result, effect)
         ranking.append(line)

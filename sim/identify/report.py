@@ -30,19 +30,22 @@ class RankedEffect:
     heldout_excess: float | None = None
     #: One-sided p-value of its held-out gain over the baseline (single test).
     p_value: float | None = None
+    #: The same as one of the family of candidates (``decide.judge``): what ALPHA judges.
+    p_family: float | None = None
     params: dict[str, float] = field(default_factory=dict)
     #: Fitted parameters that ended on a bound of their physical range: the effect may be
     #: larger than the range allows, or of another form.
     at_bound: list[str] = field(default_factory=list)
 
     def to_dict(self) -> dict[str, object]:
-        """JSON keys effect, score, heldout_error, heldout_excess, p_value, screening, ..."""
+        """JSON keys effect, score, heldout_error, heldout_excess, p_value, p_family, ..."""
         return {
             "effect": self.effect,
             "score": self.score,
             "heldout_error": self.heldout_error,
             "heldout_excess": self.heldout_excess,
             "p_value": self.p_value,
+            "p_family": self.p_family,
             "screening": self.screening,
             "params": self.params,
             "at_bound": self.at_bound,

@@ -119,7 +119,11 @@ def test_diagnose_command_on_csv_recordings_with_report(
     assert out["mass_kg"][paths[0]] == {"kg": 8.131, "source": "--mass-kg"}
     assert {"effect", "ranking", "where", "gap_before", "gap_after"} <= set(out)
     assert set(out["gap_before"]["u"]) == {"R", "psi", "nrmse"}
-    assert all({"effect", "score", "params"} <= set(r) for r in out["ranking"])
+    keys = {"effect", "score", "params", "p_value", "p_family"}
+    assert all(keys <= set(r) for r in out["ranking"])
+    # The named effect's evidence is its family p-value, what ALPHA judged.
+    named = next(r for r in out["ranking"] if r["effect"] == out["effect"])
+    assert out["effects"][0]["p_value"] == named["p_family"] <= 0.05
     page = (report / "index.html").read_text()
     assert "dial_gauge_calibration" in page and 'src="ranking.png"' in page
     for png in ("ranking.png", "residual.png", "overlay.png"):
