@@ -62,6 +62,8 @@ class EffectSpec:
                     f"{self.name}: {key} = {value:g}{unit} is outside its admissible range "
                     f"[{p.minimum:g}, {p.maximum:g}]{unit}"
                 )
+            if p.integer and value != round(value):
+                raise EffectError(f"{self.name}: {key} = {value:g} must be a whole number")
             values[key] = value
         return values
 

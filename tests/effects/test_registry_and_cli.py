@@ -77,6 +77,7 @@ def test_parse_effect_reads_name_and_parameters() -> None:
         ("fibre_viscoelastic:relaxation_time_s=fast", "must be a number (s), got 'fast'"),
         ("fibre_viscoelastic:relaxation_time_s=1e-5", "outside its admissible range"),
         ("channel_time_skew:force_skew_s=nan", "outside its admissible range"),
+        ("fibre_pulley_jump:seats=2.5", "seats = 2.5 must be a whole number"),
         ("side_load_friction:friction_coeff=0.1,friction_coeff=0.2", "given twice"),
     ],
 )
