@@ -82,10 +82,13 @@ def screen(
     y_rec = _stack(traces, [Outputs(t.u_m, t.force_n) for t in traces])
     y_base = _stack(traces, base_out)
     r = y_rec - y_base
-    # Baseline parameters' directions (forward differences), to project off.
+    # Baseline parameters' directions (forward differences), to project off. Thresholds
+    # and counts (``scan``) have no direction: the output is a step function of them.
     base_cand = base_fit.candidate
     cols = []
     for p in base_cand.params:
+        if p.scan:
+            continue
         bumped = dict(base_fit.values)
         bumped[p.name] = base_fit.values[p.name] * 1.01 if base_fit.values[p.name] else 0.01
         cols.append(_stack(traces, outputs_of(base_cand, bumped, traces, nominal)) - y_base)

@@ -301,3 +301,28 @@ def test_a_threshold_is_found_by_scanning_and_held_in_the_local_fit(stand: Stand
     # Any dwell between the longest episode shorter than 30 ms and the shortest longer
     # one explains the recording alike; the scan lands in that gap.
     assert 0.015 < scanned[f"{effect}.dwell_s"] < 0.045
+
+
+def test_screening_on_top_of_a_pulley_jump_leaves_its_thresholds_and_count_alone(
+    stand: StandConfig,
+) -> None:
+    # Screening on top of an accepted effect projects off the base fit's parameter
+    # directions. A threshold or a count has none (the output steps): bumping the seat
+    # count from 0 to 0.01 made a stand no one can build, and the diagnosis stopped there.
+    from sim.identify.fitting import FitResult
+    from sim.identify.screening import outputs_of, probe_values, screen
+
+    effect = "fibre_pulley_jump"
+    tr, _ = _trace(stand, 8.131, [EffectSpec(effect, {"step_m": 5e-4, "seats": 2.0})])
+    nominal = stand.stand_params("final", 8.131)
+    candidate = Candidate.build(effect)
+    values = dict(BASE, **{p.name: 0.0 for p in candidate.params if p.name not in BASE})
+    values.update({f"{effect}.step_m": 4e-4, f"{effect}.depth_scale_m": 1e-3})
+    base = FitResult(candidate, values, 0.0, 0)
+    scores, _, sims = screen([tr], nominal, base, outputs_of(candidate, values, [tr], nominal),
+                             ["channel_time_skew", "stick_slip_friction"])  # fmt: skip
+    scanned = sum(1 for p in candidate.params if p.scan)
+    assert sims == len(candidate.params) - scanned + sum(
+        len(probe_values(e, values)) for e in ("channel_time_skew", "stick_slip_friction")
+    )
+    assert all(0.0 <= s <= 1.0 for s in scores.values())
