@@ -58,7 +58,7 @@ class AcceptedEffect:
 
     ``closure`` is the share of the baseline's gap above the noise that adding this effect
     (on top of those before it) closed on held-out cycles; ``p_value`` its test against
-    the model before it, corrected for the number of candidates tried at that step.
+    the model before it, as one of the family of candidates tried at that step (``decide.judge``).
     ``indistinguishable_from``: candidates that explain the same part of the gap about
     as well — the recordings cannot tell them apart from this one.
     """
