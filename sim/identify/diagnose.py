@@ -265,8 +265,9 @@ def strongest_accepted(
 ) -> str | None:
     """The best held-out closure among the candidates whose evidence holds, or None.
 
-    Bonferroni bounds the chance that *any* of the ``tests`` candidates passes by luck,
-    so a candidate may be named although a better-closing one is not: on a light
+    The family test (``decide.judge``; Bonferroni over ``tests`` for evidence judged
+    alone) bounds the chance that *any* candidate passes by luck, so a candidate may be
+    named although a better-closing one is not: on a light
     string-mode and stick-slip campaign the stick-slip refit closed 0.18 at p 0.0093
     (× 9: fails), the string modes 0.14 at p 0.00096; only the first was tested, and the
     answer was ``none``.
@@ -364,10 +365,9 @@ def _second_effect(
     passing = [e for e in tries if evidence[e].accepted(len(tries))]
     if not passing:
         return None, sims
-    best_effect = min(passing, key=lambda e: fits[e].excess)
-    best = (best_effect, fits[best_effect], evidence[best_effect])
-    effect, fitted, ev = best
-    fitted = _polish(fitted, traces, nominal)
+    effect = min(passing, key=lambda e: fits[e].excess)
+    ev = evidence[effect]
+    fitted = _polish(fits[effect], traces, nominal)
     sims += fitted.result.evaluations
     line = AcceptedEffect(
         effect,

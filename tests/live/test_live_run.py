@@ -119,6 +119,8 @@ def test_a_stalled_client_costs_the_recording_nothing(
     assert report["topics"]["/gauges"]["seq"] == rec.gauges["seq"].tolist()
 
 
+# As a child process: the SDK's runtime (its threads, its epoll) lives as long as the
+# process that first started a server, so not in the test's.
 def test_busy_port_is_bad_input(tmp_path: Path) -> None:
     with socket.socket() as busy:
         busy.bind(("127.0.0.1", 0))
