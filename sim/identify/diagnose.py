@@ -48,6 +48,8 @@ from sim.identify.heldout import (
 )
 from sim.identify.report import AcceptedEffect, Diagnosis, RankedEffect
 from sim.identify.screening import outputs_of, screen
+from sim.identify.seat_probe import EFFECT as SEAT_EFFECT
+from sim.identify.seat_probe import seat_probes
 from sim.identify.shooting import dial_slope
 from sim.identify.traces import Trace
 from sim.identify.where import SimStates, where_the_gap_lies
@@ -172,6 +174,7 @@ def diagnose(
         say(f"refitting {effect} (screening score {scores[effect]:.3f})")
         started = time.perf_counter()
         probe = [probes[effect]] if effect in probes else []
+        probe += _data_starts(effect, traces, nominal, base_fit.values)
         refits[effect] = _refit(Candidate.build(effect), traces, nominal, base_fit.values, probe)
         timings[f"refit {effect}"] = time.perf_counter() - started
         sims += refits[effect].result.evaluations
@@ -356,6 +359,7 @@ def _second_effect(
     for effect in tries:
         say(f"refitting {effect} on top of {first}")
         probe = [probes[effect]] if effect in probes else []
+        probe += _data_starts(effect, traces, nominal, current.result.values)
         fits[effect] = _refit(
             Candidate.build(first, effect), traces, nominal, current.result.values, probe
         )
@@ -377,6 +381,13 @@ def _second_effect(
         _at_bound(fitted.result, effect),
     )
     return (line, fitted), sims
+
+
+def _data_starts(
+    effect: str, traces: Sequence[Trace], nominal: StandParams, values: dict[str, float]
+) -> list[dict[str, float]]:
+    """Start points that the recordings show directly (the pulley seat's steps)."""
+    return seat_probes(traces, nominal, values) if effect == SEAT_EFFECT else []
 
 
 def _effect_params(effect: str, values: dict[str, float]) -> dict[str, float]:

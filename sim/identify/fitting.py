@@ -290,7 +290,7 @@ def _grid_starts(objective: Objective) -> list[FloatArray]:
 EFFECT_GRID_LEVELS = {1: 8, 2: 5, 3: 2}
 
 
-def _grid_axis(p: FreeParam, levels: int) -> FloatArray:
+def grid_axis(p: FreeParam, levels: int) -> FloatArray:
     """Start-grid levels of one parameter (optimiser coordinates): dense where typical."""
     lo, hi = p.bounds()
     if p.integer:  # a count: its first level; the scan after the local fit finds the rest
@@ -331,7 +331,7 @@ def effect_grid_start(
     objective = Objective(candidate, traces, nominal, stride)
     own = [p for p in candidate.params if p.name not in baseline]
     levels = EFFECT_GRID_LEVELS.get(len(own), 2)
-    axes = [_grid_axis(p, levels) for p in own]
+    axes = [grid_axis(p, levels) for p in own]
     base = {p.name: p.to_internal(baseline[p.name]) for p in candidate.params if p.name in baseline}
     points = []
     for combo in np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, len(own)):

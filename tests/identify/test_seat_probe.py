@@ -1,0 +1,69 @@
+"""Start points for the pulley-jump refit, read off a recording's seat steps."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from drivers.signals import plan_motion
+from sim.config import StandConfig, default_config
+from sim.effects import EffectSpec
+from sim.identify.seat_probe import EFFECT, seat_probes
+from sim.identify.traces import Trace, make_trace
+from sim.model import Model
+from sim.situations import SITUATIONS
+
+BASE = {"stiffness_scale": 1.0, "damping_scale": 1.0, "friction_scale": 1.0}
+#: Force gauge noise, N rms (the validation set's order).
+NOISE_N = 0.05
+
+
+@pytest.fixture(scope="module")
+def stand() -> StandConfig:
+    return default_config()
+
+
+def _recording(stand: StandConfig, params: dict[str, float] | None) -> Trace:
+    """Situation 11 (the fibre goes slack every cycle), with the pulley jump or without."""
+    situation = SITUATIONS["11"]
+    t, x = plan_motion(situation.signal, stand.drive).sample(stand.sample_rate_hz)
+    effects = [EffectSpec(EFFECT, params)] if params is not None else []
+    nominal = stand.stand_params("final", situation.mass_kg)
+    run = Model(nominal, effects).run(x, stand.sample_rate_hz)
+    force = run.force_n + np.random.default_rng(0).normal(0.0, NOISE_N, x.size)
+    return make_trace("11", t, x, run.u_m, force, situation.mass_kg)
+
+
+def _patterns(probes: list[dict[str, float]]) -> set[tuple[float, int]]:
+    return {(round(p[f"{EFFECT}.step_m"], 5), int(p[f"{EFFECT}.seats"])) for p in probes}
+
+
+@pytest.mark.parametrize("seats", [0, 2])
+def test_the_recorded_seat_steps_give_the_step_its_sign_and_the_flank_its_seats(
+    stand: StandConfig, seats: int
+) -> None:
+    # A snap re-seat 0.6 mm *down* (the fibre's path longer): the start grid's single
+    # negative step level is −1.5 mm; the recording shows the step itself.
+    step = -6e-4
+    trace = _recording(stand, {"step_m": step, "depth_scale_m": 1e-6, "seats": float(seats)})
+    nominal = stand.stand_params("final", trace.mass_kg)
+    probes = seat_probes([trace], nominal, BASE)
+    patterns = _patterns(probes)
+    assert probes, "the steps were not seen"
+    steps = {s for s, _ in patterns}
+    assert any(abs(s - step) < 0.1 * abs(step) for s in steps)  # the first step from rest
+    if seats == 0:
+        assert (round(min(steps, key=lambda s: abs(s - step)), 5), 0) in patterns
+    else:  # the climb to the flange: two steps, or one step of the whole climb
+        assert any(n == seats and abs(s - step) < 0.1 * abs(step) for s, n in patterns)
+        assert any(n == 1 and abs(s - seats * step) < 0.1 * abs(step) for s, n in patterns)
+    for p in probes:  # the fibre left its groove at no depth: the onset is shallow
+        assert 0.0 <= p[f"{EFFECT}.onset_m"] < 1e-3
+
+
+def test_a_fibre_that_never_re_seats_proposes_no_start(stand: StandConfig) -> None:
+    # Slack every cycle, but the seat never moves: the force sits on the fibre's law
+    # within the noise after every episode, so no step is read into it.
+    trace = _recording(stand, None)
+    nominal = stand.stand_params("final", trace.mass_kg)
+    assert seat_probes([trace], nominal, BASE) == []
