@@ -72,6 +72,7 @@ class _Episodes:
 
 
 def _episodes(trace: Trace, nominal: StandParams, values: dict[str, float]) -> _Episodes | None:
+    """The recording's taut-interval offsets r and its slack episodes (None: < 2 intervals)."""
     k = nominal.stiffness_n_m * values.get("stiffness_scale", 1.0)
     c = nominal.damping_n_s_m * values.get("damping_scale", 1.0)
     n = nominal.projection
@@ -124,10 +125,12 @@ def seat_probes(
     ``values``: the baseline's fitted parameters (its stiffness and damping scales read r).
     Each recording that shows steps proposes its own: its first step (from the rest
     seat), as a toggle and as a ratchet of as many steps as its last seat is away from
-    rest, and that whole climb as one step; a recording whose model error hides the
-    steps (a chaotic bounce, a skewed channel) proposes no better or worse than the
-    others, and the grid keeps the best.
+    rest, and that whole climb as one step. A recording whose steps drown in the model's
+    error there (a chaotic bounce, a skewed channel) proposes none, or wrong ones that
+    the grid then does not keep.
     """
+    params = {p.name: p for p in Candidate.build(EFFECT).params}
+    most_seats = int(params[f"{EFFECT}.seats"].scan[-1])  # the flange's highest level
     shapes: list[tuple[float, int]] = []  # step, seats
     moved_depths: list[float] = []
     moved_lengths: list[float] = []
@@ -139,7 +142,7 @@ def seat_probes(
         if steps.size == 0:
             continue
         step, climb = float(steps[0]), float(episodes.offsets[-1])
-        seats = int(np.clip(round(climb / step), 1, 8))
+        seats = int(np.clip(round(climb / step), 1, most_seats))
         shapes += [(step, 0), (step, seats)]
         if seats > 1:
             shapes.append((climb, 1))  # the whole climb as one step
@@ -154,22 +157,21 @@ def seat_probes(
         (ONSET_SHARE * max(0.0, min(moved_depths, default=0.0)), 0.0),
         (0.0, ONSET_SHARE * min(moved_lengths)),
     ]
-    candidate = Candidate.build(EFFECT)
-    depth_param = next(p for p in candidate.params if p.name == f"{EFFECT}.depth_scale_m")
-    # The two sharpest levels of the grid: a re-seat completes within a fraction of the
-    # slack loops (every refit from these starts ended below 0.3 mm).
-    sharp = [depth_param.to_natural(float(z)) for z in grid_axis(depth_param, 2)[:2]]
+    # The grid's two sharpest depth scales: a re-seat completes within a fraction of the
+    # slack loop (every refit from these starts ended at 0.3 mm or less).
+    depth = params[f"{EFFECT}.depth_scale_m"]
+    sharp = [depth.to_natural(float(z)) for z in grid_axis(depth, 2)[:2]]
     return [
         {
             f"{EFFECT}.step_m": step,
             f"{EFFECT}.seats": float(seats),
             f"{EFFECT}.onset_m": onset,
             f"{EFFECT}.dwell_s": dwell,
-            f"{EFFECT}.depth_scale_m": depth,
+            f"{EFFECT}.depth_scale_m": scale,
         }
         for step, seats in _distinct(shapes)
         for onset, dwell in triggers
-        for depth in sharp
+        for scale in sharp
     ]
 
 
