@@ -356,12 +356,7 @@ def _second_effect(
     others = [e for e in pool if e != first]
     say(f"screening the other effects on top of {first}")
     scores, probes, sims = screen(traces, nominal, current.result, current.outputs, others)
-    tries = [e for e in sorted(others, key=lambda e: -scores[e]) if scores[e] > 0.0]
-    tries = tries[:SECOND_STAGE]
-    alone = sorted(
-        (e for e in others if trained.get(e, base_cost) < base_cost), key=trained.__getitem__
-    )
-    tries += [e for e in alone[:SECOND_STAGE] if e not in tries]
+    tries = second_tries(others, scores, trained, base_cost)
     fits: dict[str, _Fitted] = {}
     for effect in tries:
         say(f"refitting {effect} on top of {first}")
@@ -388,6 +383,23 @@ def _second_effect(
         _at_bound(fitted.result, effect),
     )
     return (line, fitted), sims
+
+
+def second_tries(
+    others: Sequence[str], scores: dict[str, float], trained: dict[str, float], base_cost: float
+) -> list[str]:
+    """The candidates tried on top of the first (``_second_effect``), in order.
+
+    ``SECOND_STAGE`` best by the score test on top (``scores``, only those above 0), then
+    up to ``SECOND_STAGE`` best by their training cost alone (``trained``) among those
+    below the baseline's ``base_cost``.
+    """
+    tries = [e for e in sorted(others, key=lambda e: -scores[e]) if scores[e] > 0.0]
+    tries = tries[:SECOND_STAGE]
+    alone = sorted(
+        (e for e in others if trained.get(e, base_cost) < base_cost), key=trained.__getitem__
+    )
+    return tries + [e for e in alone[:SECOND_STAGE] if e not in tries]
 
 
 def _data_starts(
