@@ -6,7 +6,8 @@ The gap is measured on held-out cycles, in noise units.
 2. Screen every candidate effect with a score test (``screening``): orders them and
    gives each refit a start point.
 3. Refit every candidate (baseline parameters and the effect's together, from the best
-   point of a grid over the effect's physical range) on the training cycles.
+   point of a grid over the effect's physical range, with points the recordings show
+   directly: the pulley seat's steps, ``seat_probe``) on the training cycles.
 4. Give the baseline the same chance (each candidate's baseline parameters alone), then
    judge each candidate against it on the held-out cycles (``decide``): the best closure
    among those whose gain is evidence at the family-wise rate ``ALPHA`` is named; if
