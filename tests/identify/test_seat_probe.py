@@ -42,8 +42,8 @@ def _patterns(probes: list[dict[str, float]]) -> set[tuple[float, int]]:
 def test_the_recorded_seat_steps_give_the_step_its_sign_and_the_flank_its_seats(
     stand: StandConfig, seats: int
 ) -> None:
-    # A snap re-seat 0.6 mm *down* (the fibre's path longer): the start grid's single
-    # negative step level is −1.5 mm; the recording shows the step itself.
+    # A snap re-seat 0.6 mm *down* (the fibre's path longer): the start grid's only
+    # negative step level is −0.29 mm; the recording shows the step itself.
     step = -6e-4
     trace = _recording(stand, {"step_m": step, "depth_scale_m": 1e-6, "seats": float(seats)})
     nominal = stand.stand_params("final", trace.mass_kg)
