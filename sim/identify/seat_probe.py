@@ -27,7 +27,6 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sim.identify.fitting import Candidate, grid_axis
-from sim.identify.shooting import smoothed_channels
 from sim.identify.traces import Trace
 from sim.params import StandParams
 
@@ -77,7 +76,8 @@ def _episodes(trace: Trace, nominal: StandParams, values: dict[str, float]) -> _
     c = nominal.damping_n_s_m * values.get("damping_scale", 1.0)
     n = nominal.projection
     rest_tension = nominal.preload_tension_n
-    u_s, v_s, f_s, _ = smoothed_channels(trace)
+    seg = trace.segments  # the restarts' smoothed channels, computed once per trace
+    u_s, v_s, f_s = seg.u_m, seg.v_m_s, seg.force_n
     if np.isfinite(trace.dial_slope) and trace.dial_slope > 0:  # the gauge's own scale
         u_s, v_s = u_s / (trace.dial_slope * n), v_s / (trace.dial_slope * n)
     x = trace.x_m - trace.x_m[0]

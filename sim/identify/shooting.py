@@ -154,7 +154,7 @@ def segment_trace(
 ) -> Segments:
     """Cut a trace into segments and estimate the measured state along it."""
     rate = trace.rate_hz
-    u_s, v_s, f_s, _ = smoothed_channels(trace, half_width_s)
+    u_s, v_s, f_s, _ = _smoothed(trace, half_width_s)
     warm = round(warmup_s * rate)
     body = _boundaries(f_s, rate, segment_s, warm)
     starts = np.where(body > 0, np.maximum(body - warm, 0), 0).astype(np.int64)
@@ -168,7 +168,7 @@ def segment_trace(
     return Segments(starts, lengths, body, u_s, v_s, f_s, seg_of, offset, slope)
 
 
-def smoothed_channels(
+def _smoothed(
     trace: Trace, half_width_s: float = STATE_HALF_WIDTH_S
 ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
     """u, du/dt, F and dF/dt from a local cubic fit over ±half_width_s (lost samples bridged)."""
@@ -211,7 +211,7 @@ def dial_slope(traces: Sequence[Trace]) -> float:
     targets: list[FloatArray] = []
     blocks: list[int] = []
     for trace in traces:
-        u_s, _, f_s, f_rate = smoothed_channels(trace)
+        u_s, _, f_s, f_rate = _smoothed(trace)
         x = trace.x_m - trace.x_m[0]
         taut = f_s > 0.5 * np.median(f_s)
         calm = np.abs(f_rate) < CALM_SHARE * np.max(np.abs(f_rate))
