@@ -136,8 +136,9 @@ class Model:
         self.physical = "physical" in kinds
         #: Measurement effects transform the outputs.
         self.measured = "measurement" in kinds
-        # Effects whose states the gauges cannot see carry them between segments.
-        self._chained = any(EFFECTS[e.name].carried for e in self.effects)
+        #: Effects whose states the gauges cannot see carry them from segment to segment
+        #: (``run_segments``): then every segment depends on the ones before it.
+        self.chained = any(EFFECTS[e.name].carried for e in self.effects)
 
     def __repr__(self) -> str:
         names = ", ".join(str(e) for e in self.effects) or "baseline"
@@ -247,7 +248,7 @@ class Model:
         if self.physical:
             return _augmented.simulate_augmented_segments(
                 x_rel, rate_hz, rows, table, starts, lengths, init, self.substeps,
-                chained=self._chained,
+                chained=self.chained,
             )  # fmt: skip
         u, f = _baseline.simulate_segment_rows(
             x_rel, rate_hz, base, table, starts, lengths, init[:, :, :2], self.substeps

@@ -17,6 +17,7 @@ fits are reproducible.
 from __future__ import annotations
 
 import logging
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
@@ -30,7 +31,10 @@ from sim.model import Model, Variant
 from sim.params import StandParams
 
 FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.int64]
 log = logging.getLogger(__name__)
+#: The effect whose channels may be recorded early (read ahead of the simulated run).
+SKEW = "channel_time_skew"
 
 #: Baseline multipliers: (name, low, high, log scale).
 BASELINE_PARAMS = (
@@ -176,27 +180,43 @@ class FitResult:
     evaluations: int
 
 
+def _early_s(values: dict[str, float]) -> float:
+    """How far ahead of its time a channel is recorded (a negative skew), s; 0 if none."""
+    prefix = f"{SKEW}."
+    return max([0.0] + [-v for k, v in values.items() if k.startswith(prefix)])
+
+
 def simulate_values(
     candidate: Candidate,
     values: Sequence[dict[str, float]],
     trace: Trace,
     nominal: StandParams,
     shooting: bool = True,
+    samples: IntArray | None = None,
 ) -> tuple[FloatArray, FloatArray]:
     """Recorded-channel outputs u (m), F (N) of a candidate for many value sets, in parallel.
 
     With ``shooting`` (always, in the diagnosis) each trace is simulated as segments
     restarted from measured states (``shooting``), assembled to full length; without, open
     loop from rest over the whole trace (chaotic for the light weight in quick motions).
+    ``samples``: only the outputs at these samples (sets, len(samples)), simulating only
+    the segments that hold them unless the model carries states from segment to segment.
     """
     model = candidate.model(nominal, trace.mass_kg)
     variants = [candidate.variant(nominal, v) for v in values]
     if not shooting:
         res = model.run_batch(trace.x_m, trace.rate_hz, variants)
-        return res.u_m, res.force_n
-    seg = trace.segments
-    u, f = model.run_segments(trace.x_m, trace.rate_hz, seg.restarts, variants)
-    return seg.assemble(u), seg.assemble(f)
+        u, f = res.u_m, res.force_n
+    elif samples is not None and not model.chained:
+        ahead = math.ceil(max((_early_s(v) for v in values), default=0.0) * trace.rate_hz)
+        restarts, position, offset = trace.segments.covering(samples, ahead + 1)
+        u, f = model.run_segments(trace.x_m, trace.rate_hz, restarts, variants)
+        return u[:, position, offset], f[:, position, offset]
+    else:
+        seg = trace.segments
+        u, f = model.run_segments(trace.x_m, trace.rate_hz, seg.restarts, variants)
+        u, f = seg.assemble(u), seg.assemble(f)
+    return (u, f) if samples is None else (u[:, samples], f[:, samples])
 
 
 class Objective:
@@ -218,20 +238,21 @@ class Objective:
             sf = float(np.linalg.norm(tr.force_n[idx] - tr.force_n[idx].mean())) or 1.0
             self._masks.append((idx, su, sf))
 
-    def outputs(self, zs: FloatArray, trace: Trace) -> tuple[FloatArray, FloatArray]:
-        """Simulated recorded u (m) and F (N) for parameter vectors zs (sets, params)."""
+    def outputs(
+        self, zs: FloatArray, trace: Trace, samples: IntArray
+    ) -> tuple[FloatArray, FloatArray]:
+        """Simulated recorded u (m) and F (N) at ``samples`` for parameter vectors zs."""
         self.simulations += len(zs)
-        return simulate_values(
-            self.candidate, [self.candidate.natural(z) for z in zs], trace, self.nominal
-        )
+        values = [self.candidate.natural(z) for z in zs]
+        return simulate_values(self.candidate, values, trace, self.nominal, samples=samples)
 
     def residuals_batch(self, zs: FloatArray) -> FloatArray:
         """Residual vectors for many parameter vectors at once, shape (sets, residuals)."""
         parts = []
         for tr, (idx, su, sf) in zip(self.traces, self._masks, strict=True):
-            u, f = self.outputs(zs, tr)
-            parts.append((u[:, idx] - tr.u_m[idx]) / su)
-            parts.append((f[:, idx] - tr.force_n[idx]) / sf)
+            u, f = self.outputs(zs, tr, idx)
+            parts.append((u - tr.u_m[idx]) / su)
+            parts.append((f - tr.force_n[idx]) / sf)
         out = np.concatenate(parts, axis=1)
         return np.where(np.isfinite(out), out, 1e3)  # a diverged run is simply very bad
 

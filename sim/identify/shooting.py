@@ -113,6 +113,28 @@ class Segments:
         """Segment runs (sets, segments, samples) → one series per set (sets, N)."""
         return np.asarray(runs[:, self.seg_of, self.offset])
 
+    def covering(
+        self, samples: IntArray, lookahead: int = 0
+    ) -> tuple[Restarts, IntArray, IntArray]:
+        """Restarts of only the segments whose bodies hold ``samples``; per sample its run.
+
+        For each sample: the run it lies in (position among those kept) and its index in
+        that run. Each segment restarts from measured states, so leaving out the others changes
+        nothing in these runs, and a run is causal, so it ends ``lookahead`` samples after
+        its last sample asked for (a channel recorded early reads ahead). A fit scored on
+        the training cycles simulates about two thirds of the samples.
+        """
+        keep = np.unique(self.seg_of[samples])
+        position = np.searchsorted(keep, self.seg_of[samples]).astype(np.int64)
+        offset = self.offset[samples]
+        lengths = np.zeros(keep.size, dtype=np.int64)
+        np.maximum.at(lengths, position, offset + 1 + lookahead)
+        lengths = np.minimum(lengths, self.lengths[keep])
+        restarts = Restarts(
+            self.starts[keep], lengths, self.u_m, self.v_m_s, self.force_n, self.dial_slope
+        )
+        return restarts, position, offset
+
 
 def _filled(series: FloatArray) -> FloatArray:
     """Lost samples (NaN) linearly interpolated, so smoothing can run over them."""

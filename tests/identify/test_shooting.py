@@ -227,6 +227,37 @@ def test_chained_segments_equal_independent_ones_without_carried_states(
     np.testing.assert_allclose(outs[1][1], outs[0][1], rtol=0, atol=1e-7)
 
 
+@pytest.mark.parametrize(
+    ("effect", "params"),
+    [
+        (None, {}),
+        ("fibre_viscoelastic", {"branch_stiffness_n_m": 3.0e4, "relaxation_time_s": 0.05}),
+        ("fibre_pulley_jump", {"step_m": 1.3e-4, "depth_scale_m": 1.0e-5, "dwell_s": 0.0123}),
+        ("channel_time_skew", {"force_skew_s": -0.0203, "displacement_skew_s": -0.0117}),
+        ("fibre_transverse_vibration", {}),  # carried from segment to segment: all run
+    ],
+)
+def test_a_fit_simulates_only_the_segments_it_scores_and_gets_the_same_outputs(
+    stand: StandConfig, effect: str | None, params: dict[str, float]
+) -> None:
+    # The fit scores the training cycles only; every segment restarts from measured
+    # states, so the others need not run, nor a run past its last scored sample (plus
+    # the samples that an early channel reads ahead: a negative skew).
+    signal = SignalSpec(Shape.TRAPEZOIDAL, 0.025, 2.0, cycles=6, ramp_fraction=0.4)
+    spec = [EffectSpec(effect, params)] if effect else []
+    tr, _ = _trace(stand, 3.096, spec, signal=signal)
+    nominal = stand.stand_params("final", 3.096)
+    cand = Candidate.build(effect) if effect else Candidate.build()
+    values = dict(BASE, **{f"{effect}.{k}": v for k, v in params.items()})
+    samples = np.flatnonzero(tr.train)[::4]
+    full_u, full_f = simulate_values(cand, [values], tr, nominal)
+    u, f = simulate_values(cand, [values], tr, nominal, samples=samples)
+    np.testing.assert_array_equal(u, full_u[:, samples])
+    np.testing.assert_array_equal(f, full_f[:, samples])
+    restarts, _, _ = tr.segments.covering(samples)
+    assert restarts.lengths.sum() < 0.8 * tr.segments.lengths.sum()
+
+
 def test_string_modes_carry_over_so_a_ringing_fibre_restarts_right(
     stand: StandConfig,
 ) -> None:
