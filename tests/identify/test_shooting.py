@@ -258,6 +258,27 @@ def test_a_fit_simulates_only_the_segments_it_scores_and_gets_the_same_outputs(
     assert restarts.lengths.sum() < 0.8 * tr.segments.lengths.sum()
 
 
+def test_the_jacobian_reuses_the_residuals_least_squares_just_asked_for(
+    stand: StandConfig,
+) -> None:
+    # least_squares evaluates the residuals at a point, then its Jacobian there: the
+    # forward differences take the memoised residuals instead of simulating them again.
+    from sim.identify.fitting import Objective
+
+    tr, _ = _trace(stand, 3.096, [EffectSpec("fibre_viscoelastic")])
+    nominal = stand.stand_params("final", 3.096)
+    cand = Candidate.build("fibre_viscoelastic")
+    z = np.array([p.to_internal(0.5 * (p.low + p.high)) for p in cand.params])
+    cold = Objective(cand, [tr], nominal)
+    j_cold = cold.jacobian(z)
+    warm = Objective(cand, [tr], nominal)
+    warm.residuals(z)
+    before = warm.simulations
+    j_warm = warm.jacobian(z)
+    np.testing.assert_array_equal(j_warm, j_cold)
+    assert warm.simulations - before == z.size == cold.simulations - 1
+
+
 def test_string_modes_carry_over_so_a_ringing_fibre_restarts_right(
     stand: StandConfig,
 ) -> None:
