@@ -12,6 +12,8 @@ a batch runs on both cores, and when other sessions hold one its wall time doubl
 CPU time much less). Measured: situation 11's motion for 60 s at 2 kHz, 8.131 kg,
 ``Model(stand, [effect]).run`` (best of 5) and ``run_batch`` of 32 parameter sets (best
 of 2), for one cheap and one costly physical effect and all six physical ones together.
+The stiff cases (a light pulley at four times the damping, LuGre at
+σ₀ = 1e6 N/m) show the exponential step of the rim and the bristle (docs/effects.md).
 Compile time is excluded (each process compiles nothing once numba's cache is warm:
 run the script once before timing a fresh tree).
 """
@@ -31,17 +33,30 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent.parent
 RATE = 2000.0
 # Spelled out, not read from a registry: both trees (old and new) must run the same list.
-CASES = {
-    "side_load_friction": ["side_load_friction"],
-    "pulley_inertia_friction": ["pulley_inertia_friction"],
-    "all six physical": [
-        "fibre_viscoelastic",
-        "fibre_transverse_vibration",
-        "fibre_pulley_jump",
-        "pulley_inertia_friction",
-        "stick_slip_friction",
-        "side_load_friction",
-    ],
+# Per case: the effects with their parameters, and a factor on the stand's damping.
+Case = tuple[list[tuple[str, dict[str, float]]], float]
+CASES: dict[str, Case] = {
+    "side_load_friction": ([("side_load_friction", {})], 1.0),
+    "pulley_inertia_friction": ([("pulley_inertia_friction", {})], 1.0),
+    # The stiff decays (ETDRK4 where it pays, docs/effects.md): a light, damped pulley's
+    # rim and a stiff LuGre bristle.
+    "light pulley, 4x damping": ([("pulley_inertia_friction", {"inertia_kg_m2": 1e-5})], 4.0),
+    "stick_slip_friction": ([("stick_slip_friction", {})], 1.0),
+    "LuGre at 1e6 N/m": ([("stick_slip_friction", {"bristle_stiffness_n_m": 1e6})], 1.0),
+    "all six physical": (
+        [
+            (name, {})
+            for name in (
+                "fibre_viscoelastic",
+                "fibre_transverse_vibration",
+                "fibre_pulley_jump",
+                "pulley_inertia_friction",
+                "stick_slip_friction",
+                "side_load_friction",
+            )
+        ],
+        1.0,
+    ),
 }
 
 
@@ -58,6 +73,8 @@ def best_of(fn: Callable[[], object], repeats: int) -> list[float]:
 
 def measure(seconds: float, batch: int) -> dict[str, list[float]]:
     """{case: [run, run CPU, batch, batch CPU] (s)} in this process (its tree on sys.path)."""
+    import dataclasses
+
     import numpy as np
 
     from drivers.signals import SignalSpec, plan_motion
@@ -71,19 +88,20 @@ def measure(seconds: float, batch: int) -> dict[str, list[float]]:
     cycles = max(1, round((seconds - 1.5) * s11.signal.frequency_hz))
     spec = SignalSpec(**{**s11.signal.__dict__, "cycles": cycles})
     _, x = plan_motion(spec, stand.drive).sample(RATE)
-    params = stand.stand_params("final", s11.mass_kg)
-    rng = np.random.default_rng(1)
-    variants = [
-        {
-            "stiffness_n_m": params.stiffness_n_m * rng.uniform(0.75, 1.25),
-            "damping_n_s_m": params.damping_n_s_m * rng.uniform(0.75, 1.25),
-            "friction_scale": rng.uniform(0.75, 1.25),
-        }
-        for _ in range(batch)
-    ]
+    nominal = stand.stand_params("final", s11.mass_kg)
     out = {}
-    for case, names in CASES.items():
-        model = Model(params, [EffectSpec(name) for name in names])
+    for case, (effects, damping) in CASES.items():
+        params = dataclasses.replace(nominal, damping_n_s_m=nominal.damping_n_s_m * damping)
+        rng = np.random.default_rng(1)
+        variants = [
+            {
+                "stiffness_n_m": params.stiffness_n_m * rng.uniform(0.75, 1.25),
+                "damping_n_s_m": params.damping_n_s_m * rng.uniform(0.75, 1.25),
+                "friction_scale": rng.uniform(0.75, 1.25),
+            }
+            for _ in range(batch)
+        ]
+        model = Model(params, [EffectSpec(name, values) for name, values in effects])
         model.run(x[:100], RATE)  # load (or compile) the kernel
         model.run_batch(x[:100], RATE, variants[:2])
         single = best_of(partial(model.run, x, RATE), 5)

@@ -60,15 +60,34 @@ def probe_values(effect: str, baseline: dict[str, float]) -> list[dict[str, floa
     return probes
 
 
-def _stack(traces: Sequence[Trace], outs: Sequence[Outputs]) -> FloatArray:
-    """Normalised training-sample vector of outputs (u and F per trace)."""
+def _scored(trace: Trace) -> NDArray[np.int64]:
+    """The training samples the score test compares (every fourth, as the fits)."""
+    return np.flatnonzero(trace.present & trace.train)[::4]
+
+
+def _stack(traces: Sequence[Trace], outs: Sequence[Outputs], scored: bool = False) -> FloatArray:
+    """Normalised training-sample vector of outputs (u and F per trace).
+
+    ``outs`` hold every sample, or with ``scored`` only the compared ones (``_scored``).
+    """
     parts = []
     for tr, o in zip(traces, outs, strict=True):
-        idx = np.flatnonzero(tr.present & tr.train)[::4]
+        idx = _scored(tr)
         for rec, sim in ((tr.u_m, o.u_m), (tr.force_n, o.force_n)):
             spread = float(np.linalg.norm(rec[idx] - rec[idx].mean())) or 1.0
-            parts.append(sim[idx] / spread)
+            parts.append((sim if scored else sim[idx]) / spread)
     return np.concatenate(parts)
+
+
+def _stack_of(
+    candidate: Candidate, values: dict[str, float], traces: Sequence[Trace], nominal: StandParams
+) -> FloatArray:
+    """``_stack`` of a candidate's outputs, simulating only what the score test compares."""
+    outs = []
+    for tr in traces:
+        u, f = simulate_values(candidate, [values], tr, nominal, samples=_scored(tr))
+        outs.append(Outputs(u[0], f[0]))
+    return _stack(traces, outs, scored=True)
 
 
 def screen(
@@ -91,7 +110,7 @@ def screen(
             continue
         bumped = dict(base_fit.values)
         bumped[p.name] = base_fit.values[p.name] * 1.01 if base_fit.values[p.name] else 0.01
-        cols.append(_stack(traces, outputs_of(base_cand, bumped, traces, nominal)) - y_base)
+        cols.append(_stack_of(base_cand, bumped, traces, nominal) - y_base)
     jb = np.stack(cols, axis=1)
     q, _ = np.linalg.qr(jb)
     r_perp = r - q @ (q.T @ r)
@@ -104,7 +123,7 @@ def screen(
         cand = Candidate.build(*base_cand.effects, effect)
         best = 0.0
         for values in probe_values(effect, base_fit.values):
-            d = _stack(traces, outputs_of(cand, values, traces, nominal)) - y_base
+            d = _stack_of(cand, values, traces, nominal) - y_base
             sims += 1
             d_perp = d - q @ (q.T @ d)
             denom = float(d_perp @ d_perp)
