@@ -30,6 +30,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from sim.effects import EFFECTS
+from sim.identify.branch_starts import EFFECT as BRANCH_EFFECT
+from sim.identify.branch_starts import branch_starts
 from sim.identify.decide import Evidence, compare, judge
 from sim.identify.fitting import (
     Candidate,
@@ -406,8 +408,16 @@ def second_tries(
 def _data_starts(
     effect: str, traces: Sequence[Trace], nominal: StandParams, values: dict[str, float]
 ) -> list[dict[str, float]]:
-    """Start points that the recordings show directly (the pulley seat's steps)."""
-    return seat_probes(traces, nominal, values) if effect == SEAT_EFFECT else []
+    """Start points the recordings or the fit show directly.
+
+    The pulley seat's steps (``seat_probe``); the Maxwell branch with the share of it
+    that the fit's stiffness and damping absorbed given back (``branch_starts``).
+    """
+    if effect == SEAT_EFFECT:
+        return seat_probes(traces, nominal, values)
+    if effect == BRANCH_EFFECT:
+        return branch_starts(traces, nominal, values)
+    return []
 
 
 def _effect_params(effect: str, values: dict[str, float]) -> dict[str, float]:
