@@ -230,9 +230,11 @@ def diagnose(
         )
         started = time.perf_counter()
         trained = {e: f.result.train_cost for e, f in refits.items()}
+        alone = {e: _own_values(e, f.result.values) for e, f in refits.items()}
         second, second_sims = _second_effect(
-            best, current, trained, base_fit.train_cost, pool, traces, nominal, x_base, say
-        )
+            best, current, trained, alone, base_fit.train_cost, pool, traces, nominal, x_base,
+            say,
+        )  # fmt: skip
         sims += second_sims
         timings["second_effect"] = time.perf_counter() - started
         if second is not None:
@@ -337,6 +339,7 @@ def _second_effect(
     first: str,
     current: _Fitted,
     trained: dict[str, float],
+    alone: dict[str, dict[str, float]],
     base_cost: float,
     pool: Sequence[str],
     traces: Sequence[Trace],
@@ -355,6 +358,8 @@ def _second_effect(
     ``first``. (Chosen by their held-out closure alone, a heavy pulley's inertia behind a
     gauge low-pass was never tried: its refit fitted the training cycles third best,
     0.028 against the baseline's 0.039, but closed −0.2 against the best baseline.)
+    Each try's start grid also holds its own refit alone (``alone``: its parameters
+    there), a basin the training cycles have shown already.
     """
     others = [e for e in pool if e != first]
     say(f"screening the other effects on top of {first}")
@@ -365,6 +370,7 @@ def _second_effect(
         say(f"refitting {effect} on top of {first}")
         probe = [probes[effect]] if effect in probes else []
         probe += _data_starts(effect, traces, nominal, current.result.values)
+        probe += [alone[effect]] if effect in alone else []
         fits[effect] = _refit(
             Candidate.build(first, effect), traces, nominal, current.result.values, probe
         )
@@ -418,6 +424,11 @@ def _data_starts(
     if effect == BRANCH_EFFECT:
         return branch_starts(traces, nominal, values)
     return []
+
+
+def _own_values(effect: str, values: dict[str, float]) -> dict[str, float]:
+    """An effect's own parameters in a fit's values, keyed as the fit keys them."""
+    return {k: v for k, v in values.items() if k.startswith(f"{effect}.")}
 
 
 def _effect_params(effect: str, values: dict[str, float]) -> dict[str, float]:
