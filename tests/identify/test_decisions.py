@@ -97,10 +97,10 @@ def test_an_effect_the_first_one_hides_is_found_on_top_of_it(stand: StandConfig)
 def test_a_second_effect_starts_where_its_refit_alone_ended(
     stand: StandConfig, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    # The pulley's refit is fragile: the same campaign's pulley on top of a gauge
-    # low-pass ended in another basin after a 0.1 % change of its objective. Its own
-    # refit alone has shown a basin on these training cycles, so the second stage's start
-    # grid holds it, and the start it picks is no worse than that point.
+    # The pulley's refit is fragile: on the other stand (seed 1) a pulley on top of a
+    # gauge low-pass ended in another basin after a 0.1 % change of its objective. Its
+    # own refit alone has shown a basin on the training cycles, so every second-stage
+    # start grid holds where that refit ended.
     import importlib
 
     module = importlib.import_module("sim.identify.diagnose")
