@@ -419,11 +419,12 @@ def _data_starts(
     The pulley seat's steps (``seat_probe``); the Maxwell branch with the share of it
     that the fit's stiffness and damping absorbed given back (``branch_starts``).
     """
-    if effect == SEAT_EFFECT:
-        return seat_probes(traces, nominal, values)
-    if effect == BRANCH_EFFECT:
-        return branch_starts(traces, nominal, values)
-    return []
+    starts = _DATA_STARTS.get(effect)
+    return starts(traces, nominal, values) if starts is not None else []
+
+
+#: Each effect's start points from the recordings or the fit (``_data_starts``).
+_DATA_STARTS = {SEAT_EFFECT: seat_probes, BRANCH_EFFECT: branch_starts}
 
 
 def _own_values(effect: str, values: dict[str, float]) -> dict[str, float]:
@@ -432,8 +433,8 @@ def _own_values(effect: str, values: dict[str, float]) -> dict[str, float]:
 
 
 def _effect_params(effect: str, values: dict[str, float]) -> dict[str, float]:
-    prefix = f"{effect}."
-    return {k[len(prefix) :]: v for k, v in values.items() if k.startswith(prefix)}
+    """An effect's own parameters in a fit's values, by their own names."""
+    return {k[len(effect) + 1 :]: v for k, v in _own_values(effect, values).items()}
 
 
 def _at_bound(res: FitResult, effect: str) -> list[str]:

@@ -219,6 +219,16 @@ def simulate_values(
     return (u, f) if samples is None else (u[:, samples], f[:, samples])
 
 
+def scored_samples(trace: Trace, stride: int = 4) -> IntArray:
+    """The training samples a fit (and the score test) compares: every ``stride``-th."""
+    return np.flatnonzero(trace.present & trace.train)[::stride]
+
+
+def channel_spread(recorded: FloatArray, samples: IntArray) -> float:
+    """A channel's spread over the compared samples, its residuals' unit (1 if flat)."""
+    return float(np.linalg.norm(recorded[samples] - recorded[samples].mean())) or 1.0
+
+
 class Objective:
     """Residuals of a candidate over traces; simulations batched across parameter sets."""
 
@@ -233,10 +243,8 @@ class Objective:
         self._cache: dict[bytes, FloatArray] = {}
         self._masks = []
         for tr in self.traces:
-            idx = np.flatnonzero(tr.present & tr.train)[::stride]
-            su = float(np.linalg.norm(tr.u_m[idx] - tr.u_m[idx].mean())) or 1.0
-            sf = float(np.linalg.norm(tr.force_n[idx] - tr.force_n[idx].mean())) or 1.0
-            self._masks.append((idx, su, sf))
+            idx = scored_samples(tr, stride)
+            self._masks.append((idx, channel_spread(tr.u_m, idx), channel_spread(tr.force_n, idx)))
 
     def outputs(
         self, zs: FloatArray, trace: Trace, samples: IntArray

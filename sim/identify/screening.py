@@ -15,7 +15,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sim.effects import EFFECTS
-from sim.identify.fitting import Candidate, FitResult, simulate_values
+from sim.identify.fitting import (
+    Candidate,
+    FitResult,
+    channel_spread,
+    scored_samples,
+    simulate_values,
+)
 from sim.identify.heldout import Outputs
 from sim.identify.traces import Trace
 from sim.params import StandParams
@@ -60,22 +66,17 @@ def probe_values(effect: str, baseline: dict[str, float]) -> list[dict[str, floa
     return probes
 
 
-def _scored(trace: Trace) -> NDArray[np.int64]:
-    """The training samples the score test compares (every fourth, as the fits)."""
-    return np.flatnonzero(trace.present & trace.train)[::4]
-
-
 def _stack(traces: Sequence[Trace], outs: Sequence[Outputs], scored: bool = False) -> FloatArray:
     """Normalised training-sample vector of outputs (u and F per trace).
 
-    ``outs`` hold every sample, or with ``scored`` only the compared ones (``_scored``).
+    ``outs`` hold every sample, or with ``scored`` only the compared ones
+    (``scored_samples``).
     """
     parts = []
     for tr, o in zip(traces, outs, strict=True):
-        idx = _scored(tr)
+        idx = scored_samples(tr)
         for rec, sim in ((tr.u_m, o.u_m), (tr.force_n, o.force_n)):
-            spread = float(np.linalg.norm(rec[idx] - rec[idx].mean())) or 1.0
-            parts.append((sim if scored else sim[idx]) / spread)
+            parts.append((sim if scored else sim[idx]) / channel_spread(rec, idx))
     return np.concatenate(parts)
 
 
@@ -85,7 +86,7 @@ def _stack_of(
     """``_stack`` of a candidate's outputs, simulating only what the score test compares."""
     outs = []
     for tr in traces:
-        u, f = simulate_values(candidate, [values], tr, nominal, samples=_scored(tr))
+        u, f = simulate_values(candidate, [values], tr, nominal, samples=scored_samples(tr))
         outs.append(Outputs(u[0], f[0]))
     return _stack(traces, outs, scored=True)
 
