@@ -45,30 +45,32 @@ def start_states(
     init = np.zeros((rows2.shape[0], starts.size, ek.N_INIT))
     for b, row in enumerate(rows2):
         on = [info for info in EFFECTS.values() if row[info.flag_column] > 0]
-        u, v = _true_u(row, on, u_m, v_m_s, dial_slope)
+        u, v, force = _true_channels(row, on, rate_hz, u_m, v_m_s, force_n, dial_slope)
         init[b, :, ek.I_U] = u[starts]
         init[b, :, ek.I_V] = v[starts]
-        init[b, :, ek.I_F] = force_n[starts]
-        measured = Measured(x_rel_m, rate_hz, u_m, u, v, force_n)
+        init[b, :, ek.I_F] = force[starts]
+        measured = Measured(x_rel_m, rate_hz, u_m, u, v, force)
         for info in on:
             if info.start_state is not None:
                 info.start_state(row, measured, starts, init[b])
     return init
 
 
-def _true_u(
+def _true_channels(
     row: FloatArray,
     on: list[EffectInfo],
+    rate_hz: float,
     u_m: FloatArray,
     v_m_s: FloatArray,
+    force_n: FloatArray,
     dial_slope: float,
-) -> tuple[FloatArray, FloatArray]:
-    """The weight's u and v on the model's scale from the recorded (smoothed) channel."""
-    u, v = u_m, v_m_s
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """The weight's u and v on the model's scale and the force, from the recorded ones."""
+    u, v, force = u_m, v_m_s, force_n
     for info in on:
         if info.true_channels is not None:
-            u, v = info.true_channels(row, u, v)
+            u, v, force = info.true_channels(row, rate_hz, u, v, force)
     if np.isfinite(dial_slope) and dial_slope > 0:
         scale = dial_slope * row[ek.P_PROJ]
         u, v = u / scale, v / scale
-    return u, v
+    return u, v, force

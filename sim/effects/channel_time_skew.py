@@ -16,11 +16,21 @@ FloatArray = NDArray[np.float64]
 
 
 def _true_channels(
-    row: FloatArray, u_m: FloatArray, v_m_s: FloatArray
-) -> tuple[FloatArray, FloatArray]:
-    # A displacement channel recorded Δt late shows the true u of Δt earlier, so the
-    # true u now is u_rec(t + Δt) ≈ u_rec + Δt·v.
-    return u_m + row[ek.R_CS_DISP] * v_m_s, v_m_s
+    row: FloatArray, rate_hz: float, u_m: FloatArray, v_m_s: FloatArray, force_n: FloatArray
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    # A channel recorded Δt late shows now the true value of Δt earlier: the true value
+    # now is the recorded one Δt later, read between samples. (The first-order
+    # u_rec + Δt·v missed by ½·a·Δt² in a light weight's bounce: 0.9 mm at 6 ms and
+    # 50 m/s², and kept v and the force unshifted; the true model restarted so predicted
+    # a quick light-weight trace's force with an NRMSE of 0.9.)
+    def shifted(series: FloatArray, delay_s: float) -> FloatArray:
+        if delay_s == 0.0:
+            return series
+        at = np.arange(series.size) + delay_s * rate_hz
+        return np.asarray(np.interp(at, np.arange(series.size), series), dtype=np.float64)
+
+    displacement, force = row[ek.R_CS_DISP], row[ek.R_CS_FORCE]
+    return shifted(u_m, displacement), shifted(v_m_s, displacement), shifted(force_n, force)
 
 
 # The same declarative shape in every effect module (what it means: sim/effects/info.py).

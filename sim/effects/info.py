@@ -52,7 +52,8 @@ class Measured:
 
     ``u_rec_m`` is the recorded (smoothed) displacement channel; ``u_m``, ``v_m_s`` the
     weight's displacement and velocity on the model's scale (the gauge effects inverted);
-    ``x_rel_m`` the drive relative to rest; ``force_n`` the recorded force.
+    ``x_rel_m`` the drive relative to rest; ``force_n`` the recorded (smoothed) force on
+    the drive's time base (a skewed force channel shifted back).
     """
 
     x_rel_m: FloatArray
@@ -66,9 +67,12 @@ class Measured:
 #: Fills an effect's columns of ``init`` (segments, ``kernel.N_INIT``) for one kernel row:
 #: ``start_state(row, measured, starts, init)``.
 StartState = Callable[[FloatArray, Measured, IntArray, FloatArray], None]
-#: A gauge effect's inverse: ``true_channels(row, u, v)`` → (u, v) on the model's scale
-#: from the recorded ones.
-TrueChannels = Callable[[FloatArray, FloatArray, FloatArray], tuple[FloatArray, FloatArray]]
+#: A gauge effect's inverse: ``true_channels(row, rate_hz, u, v, force)`` → (u, v, force)
+#: on the model's scale from the recorded ones.
+TrueChannels = Callable[
+    [FloatArray, float, FloatArray, FloatArray, FloatArray],
+    tuple[FloatArray, FloatArray, FloatArray],
+]
 
 
 @dataclass(frozen=True)
@@ -147,7 +151,7 @@ class EffectInfo:
     carried: bool = False
     #: Sets its states at each segment start from the measurements (``StartState``).
     start_state: StartState | None = None
-    #: A gauge effect's inverse: the true u, v from the recorded ones (``TrueChannels``).
+    #: A gauge effect's inverse: the true u, v, force from the recorded ones (``TrueChannels``).
     true_channels: TrueChannels | None = None
     #: Refuses a stand it cannot run on (EffectError), e.g. one without a drive span.
     check_stand: Callable[[StandParams], None] | None = None

@@ -204,17 +204,18 @@ def simulate_values(
     """
     model = candidate.model(nominal, trace.mass_kg)
     variants = [candidate.variant(nominal, v) for v in values]
+    ahead = math.ceil(max((_early_s(v) for v in values), default=0.0) * trace.rate_hz)
     if not shooting:
         res = model.run_batch(trace.x_m, trace.rate_hz, variants)
         u, f = res.u_m, res.force_n
     elif samples is not None and not model.chained:
-        ahead = math.ceil(max((_early_s(v) for v in values), default=0.0) * trace.rate_hz)
         restarts, position, offset = trace.segments.covering(samples, ahead + 1)
         u, f = model.run_segments(trace.x_m, trace.rate_hz, restarts, variants)
         return u[:, position, offset], f[:, position, offset]
     else:
         seg = trace.segments
-        u, f = model.run_segments(trace.x_m, trace.rate_hz, seg.restarts, variants)
+        restarts = seg.restarts_ahead(ahead + 1 if ahead else 0)
+        u, f = model.run_segments(trace.x_m, trace.rate_hz, restarts, variants)
         u, f = seg.assemble(u), seg.assemble(f)
     return (u, f) if samples is None else (u[:, samples], f[:, samples])
 

@@ -105,9 +105,17 @@ class Segments:
     @property
     def restarts(self) -> Restarts:
         """The segment starts and measured channels, as the model takes them."""
-        return Restarts(
-            self.starts, self.lengths, self.u_m, self.v_m_s, self.force_n, self.dial_slope
-        )
+        return self.restarts_ahead(0)
+
+    def restarts_ahead(self, lookahead: int) -> Restarts:
+        """``restarts`` with every run going on ``lookahead`` samples past its own end.
+
+        A channel recorded early reads ahead of the simulated run; a run that ended with
+        its body held its last value there (a force recorded 4 ms early: 5× the held-out
+        error of one open-loop run).
+        """
+        lengths = np.minimum(self.lengths + lookahead, self.seg_of.size - self.starts)
+        return Restarts(self.starts, lengths, self.u_m, self.v_m_s, self.force_n, self.dial_slope)
 
     def assemble(self, runs: FloatArray) -> FloatArray:
         """Segment runs (sets, segments, samples) → one series per set (sets, N)."""
@@ -129,7 +137,7 @@ class Segments:
         offset = self.offset[samples]
         lengths = np.zeros(keep.size, dtype=np.int64)
         np.maximum.at(lengths, position, offset + 1 + lookahead)
-        lengths = np.minimum(lengths, self.lengths[keep])
+        lengths = np.minimum(lengths, self.seg_of.size - self.starts[keep])
         restarts = Restarts(
             self.starts[keep], lengths, self.u_m, self.v_m_s, self.force_n, self.dial_slope
         )
