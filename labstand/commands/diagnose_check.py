@@ -229,6 +229,12 @@ def _report(args: argparse.Namespace, out: dict[str, Any]) -> int:
         f"{out['cases']} blind campaigns (seed {args.seed}, truth {args.truth}): top-1 accuracy "
         f"{out['accuracy']:.2f}, false alarms on none {out['false_alarm_rate']:.2f}"
     )
+    if out["unidentifiable"]:
+        print(
+            f"  {out['unidentifiable']} campaign(s) whose true model is itself no evidence "
+            f"against the fitted baseline; with none counted right there: "
+            f"{out['accuracy_identifiable']:.2f}"
+        )
     print(
         f"median NRMSE shrink (correct answers) {out['median_shrink']:.2f}, "
         f"the true model's {out['oracle_median_shrink']:.2f}"

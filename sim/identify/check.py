@@ -32,6 +32,7 @@ from sim.config import StandConfig
 from sim.effects import EFFECTS, EffectSpec
 from sim.effects.realism import MeasurementNoise, NoiseSpec, draw_real_stand
 from sim.identify.check_other import PairCase, named_effects, other_campaign_traces, pairs_summary
+from sim.identify.decide import compare
 from sim.identify.diagnose import diagnose
 from sim.identify.fitting import Candidate, simulate_values
 from sim.identify.heldout import Outputs, heldout_error
@@ -78,6 +79,15 @@ class Case:
     shrink: float
     oracle_shrink: float
     seconds: float
+    #: Whether the true model itself is evidence against the fitted baseline (the
+    #: decision's test, as a single test); None where it cannot be judged alike (the
+    #: other stand's truth is open loop). False: ``none`` is a right answer too.
+    identifiable: bool | None = None
+
+    @property
+    def right(self) -> bool:
+        """The truth named, or ``none`` for a truth the recordings cannot show."""
+        return self.answer == self.truth or (self.identifiable is False and self.answer == "none")
 
 
 @dataclass
@@ -100,6 +110,9 @@ class CheckResult:
         return {
             "cases": n,
             "accuracy": len(correct) / n if n else 0.0,
+            # Also right: ``none`` where the true model is no evidence either (``Case``).
+            "accuracy_identifiable": sum(c.right for c in self.cases) / n if n else 0.0,
+            "unidentifiable": sum(c.identifiable is False for c in self.cases),
             "false_alarm_rate": (
                 sum(c.answer != "none" for c in nones) / len(nones) if nones else 0.0
             ),
@@ -266,7 +279,14 @@ def diagnose_case(
     shrink = (e_before - d.heldout_error_after) / e_before if e_before > 0 else 0.0
     e_true = heldout_error(traces, oracle)
     oracle_shrink = (e_before - e_true) / e_before if e_before > 0 else 0.0
-    case = Case(spec.truth, spec.mass_kg, d.effect, params, shrink, oracle_shrink, seconds)
+    identifiable = None
+    if truth_stand == "same" and spec.truth != "none":
+        # The truth judged like a candidate against the fitted baseline: if even it is
+        # no evidence of an effect, ``none`` is what the recordings show.
+        identifiable = compare(traces, d.outputs_before, oracle).accepted(tests=1)
+    case = Case(
+        spec.truth, spec.mass_kg, d.effect, params, shrink, oracle_shrink, seconds, identifiable
+    )
     return case, d
 
 

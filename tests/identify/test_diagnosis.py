@@ -13,7 +13,7 @@ from labstand.campaigns import trace_of
 from labstand.cli import main
 from sim.config import StandConfig
 from sim.identify import DiagnosisInputError, diagnose
-from sim.identify.check import SMALL_CAMPAIGN, make_campaign, run_check
+from sim.identify.check import SMALL_CAMPAIGN, Case, CheckResult, make_campaign, run_check
 from sim.identify.traces import PHASE_FALL, PHASE_HOLD, PHASE_REST, PHASE_RISE
 
 
@@ -164,3 +164,23 @@ def test_small_blind_check_scores_its_answers(stand: StandConfig) -> None:
     assert result["false_alarm_rate"] == 0.0
     # The diagnosis shrinks the gap about as far as the true model does.
     assert result["median_shrink"] >= 0.8 * result["oracle_median_shrink"] > 0
+    # The true gauge error is itself evidence against the fitted baseline; none has none.
+    identifiable = {c["truth"]: c["identifiable"] for c in result["details"]}
+    assert identifiable == {"none": None, "dial_gauge_calibration": True}
+
+
+def test_none_is_right_where_the_truth_itself_is_no_evidence() -> None:
+    def case(truth: str, answer: str, identifiable: bool | None) -> Case:
+        return Case(truth, 3.096, answer, {}, 0.0, 0.0, 1.0, identifiable)
+
+    result = CheckResult(
+        [
+            case("fibre_transverse_vibration", "none", False),  # drawn too small to show
+            case("fibre_pulley_jump", "none", True),  # shown, missed
+            case("channel_time_skew", "force_gauge_dynamics", False),  # a wrong name stays wrong
+            case("none", "none", None),
+        ]
+    ).to_dict()
+    assert result["accuracy"] == 0.25
+    assert result["accuracy_identifiable"] == 0.5
+    assert result["unidentifiable"] == 2
