@@ -279,26 +279,38 @@ def test_the_jacobian_reuses_the_residuals_least_squares_just_asked_for(
     assert warm.simulations - before == z.size == cold.simulations - 1
 
 
+def _restarted_and_open_loop_errors(
+    stand: StandConfig, effect: str, params: dict[str, float]
+) -> tuple[float, float]:
+    """Held-out errors of the true model on its own clean light-weight quick recording:
+    restarted from the recording's states (multiple shooting), and in one open-loop run."""
+    from sim.identify.heldout import Outputs, heldout_error
+
+    tr, _ = _trace(stand, 3.096, [EffectSpec(effect, params)])
+    assert segment_trace(tr).count > 3
+    values = dict(BASE, **{f"{effect}.{k}": v for k, v in params.items()})
+    nominal = stand.stand_params("final", 3.096)
+    restarted, open_loop = (
+        heldout_error([tr], [Outputs(u[0], f[0])])
+        for u, f in (
+            simulate_values(Candidate.build(effect), [values], tr, nominal, shooting=shooting)
+            for shooting in (True, False)
+        )
+    )
+    return restarted, open_loop
+
+
 def test_string_modes_carry_over_so_a_ringing_fibre_restarts_right(
     stand: StandConfig,
 ) -> None:
     # A clean recording of the true model with ringing spans (light weight, slack every
     # cycle): restarting the spans at static sag cost 5.6x the open-loop error; carried
     # over from the previous segment they predict as well as one open-loop run.
-    from sim.identify.heldout import Outputs, heldout_error
-
-    effect = "fibre_transverse_vibration"
-    spec = EffectSpec(effect, {"damping_ratio": 0.012, "load_scale": 0.6})
-    tr, _ = _trace(stand, 3.096, [spec])
-    values = dict(BASE, **{f"{effect}.damping_ratio": 0.012, f"{effect}.load_scale": 0.6})
-    cand = Candidate.build(effect)
-    nominal = stand.stand_params("final", 3.096)
-    errors = []
-    for shooting in (True, False):
-        u, f = simulate_values(cand, [values], tr, nominal, shooting=shooting)
-        errors.append(heldout_error([tr], [Outputs(u[0], f[0])]))
-    assert segment_trace(tr).count > 3
-    assert errors[0] < 1.2 * errors[1]
+    params = {"damping_ratio": 0.012, "load_scale": 0.6}
+    restarted, open_loop = _restarted_and_open_loop_errors(
+        stand, "fibre_transverse_vibration", params
+    )
+    assert restarted < 1.2 * open_loop
 
 
 @pytest.mark.parametrize(
@@ -316,18 +328,8 @@ def test_the_pulley_seat_follows_the_recorded_slack_so_restarts_keep_the_right_g
     # episode that moved it. Set from the recorded episodes, the true model predicts a
     # clean recording as well as one open-loop run (a seat estimated from the elongation
     # at each restart cost 340x).
-    from sim.identify.heldout import Outputs, heldout_error
-
-    effect = "fibre_pulley_jump"
-    tr, _ = _trace(stand, 3.096, [EffectSpec(effect, params)])
-    values = dict(BASE, **{f"{effect}.{k}": v for k, v in params.items()})
-    nominal = stand.stand_params("final", 3.096)
-    errors = []
-    for shooting in (True, False):
-        u, f = simulate_values(Candidate.build(effect), [values], tr, nominal, shooting=shooting)
-        errors.append(heldout_error([tr], [Outputs(u[0], f[0])]))
-    assert segment_trace(tr).count > 3
-    assert errors[0] < 1.2 * errors[1]
+    restarted, open_loop = _restarted_and_open_loop_errors(stand, "fibre_pulley_jump", params)
+    assert restarted < 1.2 * open_loop
 
 
 def test_a_threshold_is_found_by_scanning_and_held_in_the_local_fit(stand: StandConfig) -> None:
@@ -397,15 +399,5 @@ def test_a_skewed_channel_restarts_from_its_true_values_so_restarts_cost_nothing
     # unshifted) missed by ½·a·Δt² in the light weight's bounces, and the true model,
     # restarted, predicted the force of a quick light-weight trace with an NRMSE of 0.9.
     # A channel recorded early reads past its run's end: each run goes on that far.
-    from sim.identify.heldout import Outputs, heldout_error
-
-    effect = "channel_time_skew"
-    tr, _ = _trace(stand, 3.096, [EffectSpec(effect, params)])
-    values = dict(BASE, **{f"{effect}.{k}": v for k, v in params.items()})
-    nominal = stand.stand_params("final", 3.096)
-    errors = []
-    for shooting in (True, False):
-        u, f = simulate_values(Candidate.build(effect), [values], tr, nominal, shooting=shooting)
-        errors.append(heldout_error([tr], [Outputs(u[0], f[0])]))
-    assert segment_trace(tr).count > 3
-    assert errors[0] < 1.2 * errors[1] + 1e-3
+    restarted, open_loop = _restarted_and_open_loop_errors(stand, "channel_time_skew", params)
+    assert restarted < 1.2 * open_loop + 1e-3
