@@ -254,7 +254,7 @@ class Model:
             x_rel, rate_hz, base, table, starts, lengths, init[:, :, :2], self.substeps
         )
         if self.measured:
-            return _augmented.measure_segments(u, f, rate_hz, rows)
+            return _augmented.measure_segments(u, f, rate_hz, rows, starts, init)
         return u, f
 
     def stream(self, rate_hz: float, x0_m: float = 0.0) -> ModelStream:

@@ -49,6 +49,7 @@ def start_states(
         init[b, :, ek.I_U] = u[starts]
         init[b, :, ek.I_V] = v[starts]
         init[b, :, ek.I_F] = force[starts]
+        init[b, :, ek.I_FRATE] = np.gradient(force, 1.0 / rate_hz)[starts]
         measured = Measured(x_rel_m, rate_hz, u_m, u, v, force)
         for info in on:
             if info.start_state is not None:

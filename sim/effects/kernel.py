@@ -735,8 +735,9 @@ def simulate_batch_into(x, dt, substeps, rows, knots, coef, out_u, out_v, out_t1
 
 
 # Measured start state of a segment (``simulate_segments_into``): columns of init[b, s].
-(I_U, I_V, I_F, I_HP, I_LOFF, I_LBASE, I_DEPTH, I_SLACKT) = range(8)
-N_INIT = 8
+# I_FRATE: the recorded force's rate (the force gauge filter's state, ``measure``).
+(I_U, I_V, I_F, I_HP, I_LOFF, I_LBASE, I_DEPTH, I_SLACKT, I_FRATE) = range(9)
+N_INIT = 9
 
 
 @njit(cache=True, error_model="numpy")

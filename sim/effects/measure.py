@@ -140,8 +140,12 @@ def skew_into(series, start, delay_samples, out):  # type: ignore[no-untyped-def
 
 
 @njit(cache=True, error_model="numpy")
-def measure_into(u, force, dt, m, out_u, out_f):  # type: ignore[no-untyped-def]
-    """Apply one measurement row to a whole run (from rest at sample 0)."""
+def measure_into(u, force, dt, m, gauge0, out_u, out_f):  # type: ignore[no-untyped-def]
+    """Apply one measurement row to a run.
+
+    ``gauge0``: the force gauge's output and its rate at the first sample (N, N/s), as
+    recorded; NaN: settled on the run's first force (a run from rest).
+    """
     n = u.shape[0]
     gu = np.empty(n)
     gf = np.empty(n)
@@ -150,7 +154,10 @@ def measure_into(u, force, dt, m, out_u, out_f):  # type: ignore[no-untyped-def]
         gf[k] = force[k]
     if m[M_FG_ON] > 0.0:
         state = np.empty(3)
-        state[0], state[1], state[2] = force[0], 0.0, force[0]
+        if math.isnan(gauge0[0]):
+            state[0], state[1], state[2] = force[0], 0.0, force[0]
+        else:  # the state one sample before, so that the first output is gauge0[0]
+            state[0], state[1], state[2] = gauge0[0] - gauge0[1] * dt, gauge0[1], force[0]
         gauge_filter_into(force, dt, m[M_FC], m[M_ZETA], state, gf)
     if m[M_CS_ON] > 0.0:
         skew_into(gu, 0, m[M_SKEW_U] / dt, out_u)
@@ -162,7 +169,7 @@ def measure_into(u, force, dt, m, out_u, out_f):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True, error_model="numpy")
-def measure_batch_into(u, force, dt, mrows, out_u, out_f):  # type: ignore[no-untyped-def]
+def measure_batch_into(u, force, dt, mrows, gauge0, out_u, out_f):  # type: ignore[no-untyped-def]
     """measure_into for each row (sequential: ≈ 50 µs a row, not worth threads)."""
     for b in range(mrows.shape[0]):
-        measure_into(u[b], force[b], dt, mrows[b], out_u[b], out_f[b])
+        measure_into(u[b], force[b], dt, mrows[b], gauge0[b], out_u[b], out_f[b])

@@ -401,3 +401,20 @@ def test_a_skewed_channel_restarts_from_its_true_values_so_restarts_cost_nothing
     # A channel recorded early reads past its run's end: each run goes on that far.
     restarted, open_loop = _restarted_and_open_loop_errors(stand, "channel_time_skew", params)
     assert restarted < 1.2 * open_loop + 1e-3
+
+
+@pytest.mark.parametrize(
+    "params",
+    [
+        {"cutoff_hz": 20.0, "damping_ratio": 1.0},  # slower than the warm-up: 25× before
+        {"cutoff_hz": 40.0, "damping_ratio": 0.2},  # a ringing load cell: 3.4× before
+    ],
+)
+def test_a_slow_force_gauge_restarts_where_the_recording_shows_it(
+    stand: StandConfig, params: dict[str, float]
+) -> None:
+    # The gauge filter's state is what the recording shows (the recorded force and its
+    # rate), not settled on the model's force: a 20 Hz gauge had not caught up by the end
+    # of the warm-up, and restarts cost 25× the open-loop error.
+    restarted, open_loop = _restarted_and_open_loop_errors(stand, "force_gauge_dynamics", params)
+    assert restarted < 1.5 * open_loop
