@@ -53,7 +53,7 @@ def main() -> None:
             )
             errors.append(heldout_error([trace], [Outputs(u[0], f[0])]))
         ratio = errors[0] / max(errors[1], np.finfo(float).tiny)
-        print(f"{effect:22s} {str(params):56s} {errors[0]:10.5f} {errors[1]:10.5f} {ratio:6.1f}")
+        print(f"{effect:22s} {params!s:56s} {errors[0]:10.5f} {errors[1]:10.5f} {ratio:6.1f}")
 
 
 if __name__ == "__main__":
