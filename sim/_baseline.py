@@ -8,6 +8,8 @@ StandParams into its flat arrays and back.
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -49,9 +51,17 @@ def param_vector(params: StandParams) -> FloatArray:
 
 
 def friction_arrays(table: FrictionTable | None) -> tuple[FloatArray, FloatArray]:
-    """PCHIP knots and cubic coefficients (4, segments) of μ(v) for the kernel."""
+    """PCHIP knots and cubic coefficients (4, segments) of μ(v) for the kernel (copies)."""
     if table is None:
         return np.array([0.0, 1.0]), np.zeros((4, 1))  # μ ≡ 0
+    knots, coef = _pchip_arrays(table)
+    return knots.copy(), coef.copy()
+
+
+@functools.lru_cache(maxsize=64)
+def _pchip_arrays(table: FrictionTable) -> tuple[FloatArray, FloatArray]:
+    # A fit simulates one table thousands of times (the friction scale multiplies the
+    # normal force, not μ); scipy's PCHIP set-up cost more than a short segment's run.
     pchip = table.pchip()
     return np.asarray(pchip.x, dtype=np.float64), np.ascontiguousarray(pchip.c, dtype=np.float64)
 

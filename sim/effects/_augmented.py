@@ -182,7 +182,10 @@ def measure_segments(
     the warm-up, and the true model's restarts cost 25× the open-loop error.
     """
     sets, segs, width = u.shape
-    m = np.repeat(measure.measurement_rows(rows), segs, axis=0)
+    mrows = measure.measurement_rows(rows)
+    if not mrows[:, [measure.M_DG_ON, measure.M_FG_ON, measure.M_CS_ON]].any():
+        return u, force  # no gauge effect: the recorded channels are the true ones
+    m = np.repeat(mrows, segs, axis=0)
     gauge0 = np.ascontiguousarray(init[:, :, [ek.I_F, ek.I_FRATE]], dtype=np.float64)
     gauge0[:, starts == 0, :] = np.nan
     flat_u = np.ascontiguousarray(u.reshape(sets * segs, width))

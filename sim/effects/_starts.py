@@ -43,18 +43,37 @@ def start_states(
     """
     rows2 = np.atleast_2d(rows)
     init = np.zeros((rows2.shape[0], starts.size, ek.N_INIT))
+    # Rows whose channel transforms agree share their true channels (every row of a fit
+    # but a skew's): computed once per batch, not once per row over the whole trace.
+    channels: dict[bytes, tuple[FloatArray, FloatArray, FloatArray, FloatArray]] = {}
     for b, row in enumerate(rows2):
         on = [info for info in EFFECTS.values() if row[info.flag_column] > 0]
-        u, v, force = _true_channels(row, on, rate_hz, u_m, v_m_s, force_n, dial_slope)
+        key = _transform_key(row, on)
+        if key not in channels:
+            u, v, force = _true_channels(row, on, rate_hz, u_m, v_m_s, force_n, dial_slope)
+            channels[key] = (u, v, force, np.gradient(force, 1.0 / rate_hz)[starts])
+        u, v, force, rate = channels[key]
         init[b, :, ek.I_U] = u[starts]
         init[b, :, ek.I_V] = v[starts]
         init[b, :, ek.I_F] = force[starts]
-        init[b, :, ek.I_FRATE] = np.gradient(force, 1.0 / rate_hz)[starts]
+        init[b, :, ek.I_FRATE] = rate
         measured = Measured(x_rel_m, rate_hz, u_m, u, v, force)
         for info in on:
             if info.start_state is not None:
                 info.start_state(row, measured, starts, init[b])
     return init
+
+
+def _transform_key(row: FloatArray, on: list[EffectInfo]) -> bytes:
+    """What ``_true_channels`` depends on in a row.
+
+    The gauge's scale and, for each effect with an inverse, its flag and parameters.
+    """
+    parts = [row[ek.P_PROJ]]
+    for info in on:
+        if info.true_channels is not None:
+            parts += [float(info.flag_column)] + [row[p.column] for p in info.params]
+    return np.asarray(parts, dtype=np.float64).tobytes()
 
 
 def _true_channels(

@@ -147,6 +147,40 @@ def test_restarts_take_the_displacement_on_the_dial_gauges_own_scale(
         np.testing.assert_allclose(init[0, :, ek.I_U], seg.u_m[seg.starts])
 
 
+def test_rows_of_one_batch_get_the_start_states_each_would_get_alone(stand: StandConfig) -> None:
+    # start_states computes the true channels once for rows whose channel transforms
+    # agree; a skewed row (its own true channels) and plain rows share one call.
+    p = stand.stand_params("final", 3.096)
+    tr, _ = _trace(stand, 3.096, [])
+    seg = segment_trace(tr)
+    x_rel = tr.x_m - tr.x_m[0]
+    skews = [{"force_skew_s": 0.004, "displacement_skew_s": -0.002}, {"force_skew_s": -0.006}]
+    rows = np.stack(
+        [augmented_row(p)]
+        + [augmented_row(p, [EffectSpec("channel_time_skew", s)]) for s in skews]
+        + [augmented_row(p, [EffectSpec("fibre_viscoelastic")])]
+    )
+    args = (x_rel, tr.rate_hz, seg.starts, seg.u_m, seg.v_m_s, seg.force_n, 1.01 / p.projection)
+    together = start_states(rows, *args)
+    for b, row in enumerate(rows):
+        np.testing.assert_array_equal(together[b], start_states(row[None, :], *args)[0])
+    # The skewed rows start elsewhere than the plain one, and apart from each other.
+    assert not np.array_equal(together[1, :, ek.I_F], together[0, :, ek.I_F])
+    assert not np.array_equal(together[1, :, ek.I_F], together[2, :, ek.I_F])
+
+
+def test_the_friction_table_arrays_are_the_callers_own(stand: StandConfig) -> None:
+    # The interpolant is built once per table; a caller that writes into its arrays must
+    # not change what the next run gets.
+    table = stand.stand_params("final", 3.096).friction
+    knots, coef = friction_arrays(table)
+    knots[:] = 0.0
+    coef[:] = 0.0
+    again_knots, again_coef = friction_arrays(table)
+    np.testing.assert_array_equal(again_knots, table.pchip().x)
+    np.testing.assert_array_equal(again_coef, table.pchip().c)
+
+
 @pytest.mark.parametrize("gain", [0.05, -0.137])
 def test_a_dial_gauge_error_stays_in_the_displacement_channel(
     stand: StandConfig, gain: float
