@@ -32,6 +32,9 @@ if TYPE_CHECKING:  # imported where they run: `diagnose-check --help` loads no n
 # Literal copies of sim.identify.check's TRUTHS and MASSES_KG, which imports numba: the
 # parser is built without it (tests/core/test_cli_startup.py checks that they agree).
 TRUTHS = ("same", "other")
+#: The other stand's recording sets (``sim.otherstand.campaign.OTHER_SETS``, not imported
+#: here: ``--help`` loads no numba).
+RECORDING_SETS = ("moderate", "gentle", "brisk")
 MASSES_KG = (3.096, 8.131)
 
 LABEL = "labstand diagnose-check"
@@ -81,6 +84,13 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
         "--small",
         action="store_true",
         help="short campaigns (two recordings, ~9 s): quicker, less sure",
+    )
+    parser.add_argument(
+        "--recordings",
+        choices=RECORDING_SETS,
+        help="with --truth other: the drive signals recorded per campaign: 'moderate' "
+        "(default: the validation campaigns' four), 'gentle' (three, small and slow, the "
+        "heavy weight never slack) or 'brisk' (four, quicker and larger)",
     )
     parser.add_argument("--json", action="store_true", help="print JSON (accuracy, confusion, ...)")
     parser.add_argument("-o", "--output", type=Path, help="also write the JSON here")
@@ -172,11 +182,22 @@ def _pairs(args: argparse.Namespace) -> list[tuple[str, str]]:
     return pairs
 
 
+def _recording_set(args: argparse.Namespace) -> str:
+    """The other stand's recording set asked for (CommandError, exit 2, if it cannot be)."""
+    if args.recordings is None:
+        return "small" if args.small else "moderate"
+    if args.truth != "other":
+        raise CommandError("--recordings needs --truth other", ExitCode.USAGE)
+    if args.small:
+        raise CommandError("--recordings and --small are two sets: give one", ExitCode.USAGE)
+    return str(args.recordings)
+
+
 def run(args: argparse.Namespace) -> int:
     """Run the check and report."""
     from labstand.campaign_table import campaign_row, write_results
     from sim.identify.check import CLASSES, FULL_CAMPAIGN, SMALL_CAMPAIGN, check_cases, score
-    from sim.otherstand.campaign import OTHER_FULL, OTHER_SMALL
+    from sim.otherstand.campaign import OTHER_SETS
 
     stand = load_stand(args)
     classes = _classes(args)
@@ -186,7 +207,7 @@ def run(args: argparse.Namespace) -> int:
         stand,
         SMALL_CAMPAIGN if args.small else FULL_CAMPAIGN,
         args.truth,
-        OTHER_SMALL if args.small else OTHER_FULL,
+        OTHER_SETS[_recording_set(args)],
     )
     specs = check_cases(
         args.seed, args.trials, CLASSES if classes is None else classes, args.mass_kg, pairs
@@ -197,6 +218,8 @@ def run(args: argparse.Namespace) -> int:
     out = result.to_dict()
     out["seed"] = args.seed
     out["truth"] = args.truth
+    if args.truth == "other":
+        out["recordings"] = _recording_set(args)
     failed = [r for r in results if r.value is None]
     if failed:
         out["failed"] = [{"name": r.key, "error": r.error, "worker": r.worker} for r in failed]

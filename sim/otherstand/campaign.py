@@ -3,7 +3,9 @@
 The drive signals are not the ones the candidates were developed on (those are 25 mm
 trapezoids at 2 and 1.25 Hz and a 60 mm quasi-sine): a small quick trapezoid, a
 rectangle through a slower drive, a trapezoid that slackens the fibre, and a large slow
-raised cosine, each with 0.5 s of rest before and after.
+raised cosine, each with 0.5 s of rest before and after (``OTHER_FULL``, the
+validation campaigns' set). A real lab runs other sets: a gentle one and a brisk one
+(``OTHER_SETS``) check that the diagnosis does not hold only on the set it was tuned on.
 """
 
 from __future__ import annotations
@@ -24,7 +26,10 @@ from sim.params import StandParams
 FloatArray = NDArray[np.float64]
 
 __all__ = [
+    "OTHER_BRISK",
     "OTHER_FULL",
+    "OTHER_GENTLE",
+    "OTHER_SETS",
     "OTHER_SMALL",
     "OtherCampaign",
     "OtherRecording",
@@ -43,6 +48,7 @@ class OtherRecording:
 
 
 _SLOW_DRIVE = DriveLimits(amplitude_max_m=0.090, speed_max_m_s=0.3, accel_max_m_s2=3.0)
+_BRISK_DRIVE = DriveLimits(amplitude_max_m=0.090, speed_max_m_s=0.6, accel_max_m_s2=6.0)
 
 
 def _spec(shape: Shape, a: float, f: float, cycles: int, ramp: float = 0.25) -> SignalSpec:
@@ -62,6 +68,30 @@ OTHER_SMALL = (
     OtherRecording("burst", _spec(Shape.TRAPEZOIDAL, 0.030, 1.0, 4, 0.2)),
     OtherRecording("slow", _spec(Shape.QUASI_SINUSOIDAL, 0.070, 0.4, 2)),
 )
+#: Three gentle recordings, ~22 s: small strokes, slow ramps, the fibre never slack with
+#: either weight (a stand run to spare the fibre): the effects show less, and multiple
+#: shooting has no slack episode to restart after.
+OTHER_GENTLE = (
+    OtherRecording("small", _spec(Shape.TRAPEZOIDAL, 0.005, 1.0, 5, 0.3)),
+    OtherRecording("sine", _spec(Shape.QUASI_SINUSOIDAL, 0.030, 0.8, 5)),
+    OtherRecording("long", _spec(Shape.QUASI_SINUSOIDAL, 0.050, 0.25, 2)),
+)
+#: Four brisk recordings, ~20 s: quicker and larger than the four above, a faster drive
+#: for the rectangle; three of them slacken the fibre with either weight, for most of
+#: their motion in the rectangle and the burst.
+OTHER_BRISK = (
+    OtherRecording("fast", _spec(Shape.TRAPEZOIDAL, 0.015, 3.0, 9, 0.3)),
+    OtherRecording("rect", _spec(Shape.RECTANGULAR, 0.060, 1.5, 5), _BRISK_DRIVE),
+    OtherRecording("burst", _spec(Shape.TRAPEZOIDAL, 0.040, 1.5, 5, 0.2)),
+    OtherRecording("wide", _spec(Shape.QUASI_SINUSOIDAL, 0.085, 0.5, 3)),
+)
+#: The recording sets by name (``diagnose-check --truth other --recordings NAME``).
+OTHER_SETS = {
+    "moderate": OTHER_FULL,
+    "gentle": OTHER_GENTLE,
+    "brisk": OTHER_BRISK,
+    "small": OTHER_SMALL,
+}
 
 
 def draw_true_stand(nominal: StandParams, rng: np.random.Generator) -> StandParams:

@@ -19,7 +19,7 @@ from sim.config import StandConfig
 from sim.identify.check import make_campaign
 from sim.otherstand import OTHER_EFFECTS, OTHER_PAIRS, simulate
 from sim.otherstand import _kernel as kern
-from sim.otherstand.campaign import OTHER_SMALL
+from sim.otherstand.campaign import OTHER_SETS, OTHER_SMALL, make_other_campaign
 from sim.otherstand.gauges import sample_delayed
 from sim.otherstand.stand import parameter_row
 from sim.params import StandParams
@@ -325,6 +325,22 @@ def test_other_campaigns_reach_the_check_as_traces(stand: StandConfig) -> None:
         assert float(np.std(resid)) < 1e-5  # the oracle is the noise-free recording
 
 
+@pytest.mark.parametrize("mass", [LIGHT, HEAVY])
+def test_the_recording_sets_are_what_they_say(stand: StandConfig, mass: float) -> None:
+    # The gentle set never slackens the fibre; the brisk one slackens it in three of its
+    # four recordings, more than the validation set's does.
+    def slack_shares(name: str) -> list[float]:
+        camp = make_other_campaign(
+            stand.stand_params("final", mass), [], np.random.default_rng(3), OTHER_SETS[name]
+        )
+        return [float(np.mean(f < 0.5)) for f in camp.truth_f]
+
+    assert max(slack_shares("gentle")) == 0.0
+    brisk, moderate = slack_shares("brisk"), slack_shares("moderate")
+    assert sum(share > 0.1 for share in brisk) == 3
+    assert np.mean(brisk) > 2 * np.mean(moderate)
+
+
 def test_cli_refuses_pairs_without_the_other_truth(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["diagnose-check", "--pairs", "--effects"]) == 2
     assert "--pairs needs --truth other" in capsys.readouterr().err
@@ -338,3 +354,15 @@ def test_cli_writes_the_truth_into_its_json(tmp_path: Path) -> None:
     # No campaigns at all: the report still names its truth (the real run takes minutes).
     assert main(["diagnose-check", "--truth", "other", "--effects", "-o", str(out)]) == 0
     assert json.loads(out.read_text())["truth"] == "other"
+    assert json.loads(out.read_text())["recordings"] == "moderate"
+    args = ["diagnose-check", "--truth", "other", "--recordings", "brisk", "--effects"]
+    assert main([*args, "-o", str(out)]) == 0
+    assert json.loads(out.read_text())["recordings"] == "brisk"
+
+
+def test_cli_refuses_a_recording_set_it_cannot_use(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["diagnose-check", "--recordings", "gentle", "--effects"]) == 2
+    assert "--recordings needs --truth other" in capsys.readouterr().err
+    both = ["diagnose-check", "--truth", "other", "--recordings", "gentle", "--small"]
+    assert main([*both, "--effects"]) == 2
+    assert "give one" in capsys.readouterr().err
