@@ -186,6 +186,26 @@ def test_the_best_closure_whose_evidence_holds_is_named_not_only_the_best_closur
     assert strongest_accepted(ranking, {"a": weak_a, "b": tiny_b}, tests) is None
 
 
+def test_near_the_noise_floor_closing_most_of_the_gap_counts() -> None:
+    # The other stand's gentle recordings: the baseline is already within a tenth of the
+    # noise floor (X 1.12); a force gauge low-pass takes it to 1.02 at family p 1e-4. A
+    # tenth of X (0.112) asked more than it could gain; half the gap above the floor
+    # (0.06) is the bar there, and the sliver of a gap that does not reach it is not.
+    gauge = Evidence(x_before=1.12, x_after=1.021, p_value=1e-5, blocks=29)
+    assert gauge.least_gain == pytest.approx(0.06)
+    assert gauge.accepted(9)
+    sliver = Evidence(x_before=1.12, x_after=1.09, p_value=1e-6, blocks=29)
+    assert not sliver.accepted(9)
+    # Far above the floor the tenth of X stays the bar (half the gap would be 5.85).
+    far = Evidence(x_before=12.7, x_after=12.0, p_value=1e-6, blocks=34)
+    assert far.least_gain == pytest.approx(1.27)
+    assert not far.accepted(9)
+    # Luck stays luck however close to the floor.
+    assert not Evidence(x_before=1.12, x_after=1.02, p_value=0.02, blocks=29).accepted(9)
+    # A candidate that predicts worse is never evidence, even for a baseline at the floor.
+    assert not Evidence(x_before=0.97, x_after=0.99, p_value=1e-6, blocks=29).accepted(9)
+
+
 def test_a_second_effect_is_tried_by_its_training_fit_though_it_closed_nothing_held_out() -> None:
     # The heavy pulley-inertia + gauge low-pass campaign: on top of the low-pass the score
     # test gave the pulley 0, and alone its refit closed −0.2 against the best baseline on
