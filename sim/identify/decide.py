@@ -23,9 +23,9 @@ rest before the motion, to about a tenth), below which no model difference is
 meaningful. Judged per block as log-ratios, a candidate that is 1 % better on every
 block is "consistent"; without this bar a second effect on top of the first was named
 for closing 0.3 % of the gap (the demo's Maxwell branch, then string modes at p = 0.004).
-Where the reference is itself within a tenth of the noise floor, half of its gap above
-the floor counts instead (``Evidence.least_gain``): a tenth of X would then ask more
-than the whole gap, and no effect could be named on gentle recordings.
+Near the noise floor (X < 1.25) half of the reference's gap above the floor is the bar
+instead (``Evidence.least_gain``): a tenth of X asks for most of that gap there, and
+all of it at X ≈ 1.11, so no effect could be named on gentle recordings.
 """
 
 from __future__ import annotations
@@ -46,9 +46,9 @@ ALPHA = 0.05
 #: Least improvement of X (held-out error in noise units), as a share of the reference's
 #: X, that counts at all: X's own resolution (1 noise unit is known to about 10 %).
 MIN_GAIN_OVER_NOISE = 0.1
-#: Share of the reference's gap above the noise (X − 1) that a gain closing it counts
-#: whatever X's resolution (``Evidence.least_gain``): most of what separates a model near
-#: the noise floor from it, not a sliver of it.
+#: A gain that closes this share of the reference's gap above the noise (X − 1) counts
+#: even below X's resolution (``Evidence.least_gain``): most of what separates a model
+#: near the noise floor from the floor, not a sliver of it.
 MIN_GAP_SHARE = 0.5
 
 __all__ = [
@@ -96,12 +96,12 @@ class Evidence:
     def least_gain(self) -> float:
         """The gain that counts at all: X's resolution, or half the gap above the noise.
 
-        A tenth of the reference's X (``MIN_GAIN_OVER_NOISE``), unless the reference is
-        within that of the noise floor (X = 1): then half of what separates it from the
-        floor (``MIN_GAP_SHARE``). A tenth of X alone asked more than the whole gap of a
-        baseline already near the floor: on the other stand's gentle recordings a force
-        gauge low-pass took X from 1.12 to 1.02 (the truth's 1.017) at family p 1e-4
-        and was answered ``none``.
+        The lesser of a tenth of the reference's X (``MIN_GAIN_OVER_NOISE``) and half of
+        what separates it from the noise floor, X − 1 (``MIN_GAP_SHARE``; the lesser
+        where X < 1.25). A tenth of X alone asked more than the whole gap of a baseline
+        already near the floor: on the other stand's gentle recordings a force gauge
+        low-pass took X from 1.12 to 1.02 (the truth's 1.017) at family p 1e-4 and was
+        answered ``none``.
         """
         resolution = MIN_GAIN_OVER_NOISE * max(self.x_before, 1.0)
         return min(resolution, MIN_GAP_SHARE * max(self.x_before - 1.0, 0.0))
