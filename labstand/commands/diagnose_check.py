@@ -90,7 +90,7 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
         choices=RECORDING_SETS,
         help="with --truth other: the drive signals recorded per campaign: 'moderate' "
         "(default: the validation campaigns' four), 'gentle' (three, small and slow, the "
-        "heavy weight never slack) or 'brisk' (four, quicker and larger)",
+        "fibre never slack) or 'brisk' (four, quicker and larger, mostly slack)",
     )
     parser.add_argument("--json", action="store_true", help="print JSON (accuracy, confusion, ...)")
     parser.add_argument("-o", "--output", type=Path, help="also write the JSON here")
