@@ -203,11 +203,9 @@ def run(args: argparse.Namespace) -> int:
     classes = _classes(args)
     pairs = _pairs(args)
     options = ClusterOptions.from_args(args)
+    recordings = _recording_set(args)
     setup = CheckSetup(
-        stand,
-        SMALL_CAMPAIGN if args.small else FULL_CAMPAIGN,
-        args.truth,
-        OTHER_SETS[_recording_set(args)],
+        stand, SMALL_CAMPAIGN if args.small else FULL_CAMPAIGN, args.truth, OTHER_SETS[recordings]
     )
     specs = check_cases(
         args.seed, args.trials, CLASSES if classes is None else classes, args.mass_kg, pairs
@@ -219,7 +217,7 @@ def run(args: argparse.Namespace) -> int:
     out["seed"] = args.seed
     out["truth"] = args.truth
     if args.truth == "other":
-        out["recordings"] = _recording_set(args)
+        out["recordings"] = recordings
     failed = [r for r in results if r.value is None]
     if failed:
         out["failed"] = [{"name": r.key, "error": r.error, "worker": r.worker} for r in failed]
