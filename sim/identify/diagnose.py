@@ -62,6 +62,13 @@ log = logging.getLogger(__name__)
 
 #: Optimiser evaluations per candidate refit (each a batch of simulations).
 REFIT_EVALUATIONS = 15
+#: A short refit stops once an accepted step lowers its training cost by less than this
+#: share. Measured on 36 campaigns of the other stand: the refits had reached 96–100 % of
+#: their 15 evaluations' gain (median by effect) when a step first gained less than
+#: 0.1 %, with half the evaluations. The decision asks a gain of several percent of X,
+#: the held-out error, which moves about half as much as the cost: a 0.1 % step is far
+#: below what can change it.
+REFIT_FTOL = 1e-3
 #: Further optimiser evaluations for an accepted effect, whose fit says how far the gap
 #: shrinks (the ranking needs only the short refits).
 POLISH_EVALUATIONS = 40
@@ -98,14 +105,15 @@ def _refit(
     """
     start = effect_grid_start(candidate, traces, nominal, start_from, extra)
     res = fit(
-        candidate, traces, nominal, baseline=start, single_start=True, max_nfev=REFIT_EVALUATIONS
-    )
+        candidate, traces, nominal, baseline=start, single_start=True,
+        max_nfev=REFIT_EVALUATIONS, ftol=REFIT_FTOL,
+    )  # fmt: skip
     if any(p.scan for p in candidate.params):
         scanned, cost, sims = scan_thresholds(candidate, traces, nominal, res.values)
         if cost < res.train_cost:
             again = fit(
                 candidate, traces, nominal, baseline=scanned, single_start=True,
-                max_nfev=REFIT_EVALUATIONS,
+                max_nfev=REFIT_EVALUATIONS, ftol=REFIT_FTOL,
             )  # fmt: skip
             better = again if again.train_cost < cost else FitResult(candidate, scanned, cost, 0)
             res = dataclasses.replace(

@@ -395,11 +395,13 @@ def fit(
     stride: int = 4,
     max_nfev: int = 40,
     single_start: bool = False,
+    ftol: float = 1e-8,
 ) -> FitResult:
     """Fit a candidate's free parameters on the traces' training samples (multi-start).
 
     ``single_start`` starts only from ``baseline`` (which then also holds the effect's
-    values, e.g. the screening's best probe).
+    values, e.g. the screening's best probe). ``ftol``: stop once an accepted step lowers
+    the cost by less than this share of it (and the step went as the model predicted).
     """
     objective = Objective(candidate, traces, nominal, stride)
     lo = np.array([p.bounds()[0] for p in candidate.params])
@@ -434,7 +436,7 @@ def fit(
             lambda zf, full=full: objective.residuals(full(zf)), z0[free],
             jac=lambda zf, full=full: objective.jacobian(full(zf), free),
             bounds=(lo[free], hi[free]), method="trf", x_scale="jac", max_nfev=max_nfev,
-            xtol=1e-6, ftol=1e-8,
+            xtol=1e-6, ftol=ftol,
         )  # fmt: skip
         cost = float(np.sum(sol.fun**2))
         log.debug("%s start %s -> cost %.6g (%d evals)", candidate.name, z0, cost, sol.nfev)
