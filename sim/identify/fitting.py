@@ -200,7 +200,8 @@ def simulate_values(
     restarted from measured states (``shooting``), assembled to full length; without, open
     loop from rest over the whole trace (chaotic for the light weight in quick motions).
     ``samples``: only the outputs at these samples (sets, len(samples)), simulating only
-    the segments that hold them unless the model carries states from segment to segment.
+    the segments that hold them (all up to the last of them if the model carries states
+    from segment to segment).
     """
     model = candidate.model(nominal, trace.mass_kg)
     variants = [candidate.variant(nominal, v) for v in values]
@@ -208,8 +209,12 @@ def simulate_values(
     if not shooting:
         res = model.run_batch(trace.x_m, trace.rate_hz, variants)
         u, f = res.u_m, res.force_n
-    elif samples is not None and not model.chained:
-        restarts, position, offset = trace.segments.covering(samples, ahead + 1)
+    elif samples is not None:
+        seg = trace.segments
+        if model.chained:  # as the whole trace's runs below
+            restarts, position, offset = seg.leading(samples, ahead + 1 if ahead else 0)
+        else:
+            restarts, position, offset = seg.covering(samples, ahead + 1)
         u, f = model.run_segments(trace.x_m, trace.rate_hz, restarts, variants)
         return u[:, position, offset], f[:, position, offset]
     else:
@@ -234,8 +239,14 @@ class Objective:
     """Residuals of a candidate over traces; simulations batched across parameter sets."""
 
     def __init__(
-        self, candidate: Candidate, traces: Sequence[Trace], nominal: StandParams, stride: int = 4
+        self,
+        candidate: Candidate,
+        traces: Sequence[Trace],
+        nominal: StandParams,
+        stride: int = 4,
+        share: float = 1.0,
     ) -> None:
+        """``share``: score only this leading share of each trace's training samples."""
         self.candidate = candidate
         self.traces = list(traces)
         self.nominal = nominal
@@ -245,6 +256,7 @@ class Objective:
         self._masks = []
         for tr in self.traces:
             idx = scored_samples(tr, stride)
+            idx = idx[: max(1, math.ceil(share * idx.size))]
             self._masks.append((idx, channel_spread(tr.u_m, idx), channel_spread(tr.force_n, idx)))
 
     def outputs(
@@ -323,6 +335,12 @@ def _grid_starts(objective: Objective) -> list[FloatArray]:
 #: parameters (plus one level on each side out to the physical bounds: at most 4³ = 64
 #: points, one batch).
 EFFECT_GRID_LEVELS = {1: 8, 2: 5, 3: 2}
+#: A start grid larger than this is raced: every point on the leading ``RACE_SHARE`` of
+#: each trace's training samples, then the ``RACE_FINALISTS`` best (and the points the
+#: recordings or fits show, ``extra``) on all of them.
+RACE_ABOVE = 16
+RACE_SHARE = 0.5
+RACE_FINALISTS = 6
 
 
 def grid_axis(p: FreeParam, levels: int) -> FloatArray:
@@ -362,6 +380,9 @@ def effect_grid_start(
     fit needs a start in the right basin: spread evenly over the physical ranges, which
     are decades wider, the grid lost a light-weight Maxwell branch (τ 0.08 s; the grid's
     τ levels 0.08 s apart by a factor 3.5, the refit stuck at 0.29 s).
+
+    A large grid is raced (``RACE_ABOVE``): a basin shows in half of the training cycles
+    as well as in all of them, and only the best few points need the whole cost.
     """
     objective = Objective(candidate, traces, nominal, stride)
     own = [p for p in candidate.params if p.name not in baseline]
@@ -373,6 +394,10 @@ def effect_grid_start(
         z = dict(base)
         z.update({p.name: float(v) for p, v in zip(own, combo, strict=True)})
         points.append(np.array([z[p.name] for p in candidate.params]))
+    if len(points) > RACE_ABOVE:
+        part = Objective(candidate, traces, nominal, stride, share=RACE_SHARE)
+        heats = np.sum(part.residuals_batch(np.stack(points)) ** 2, axis=1)
+        points = [points[i] for i in np.argsort(heats, kind="stable")[:RACE_FINALISTS]]
     for values in extra:
         merged = {**baseline, **values}
         points.append(

@@ -143,6 +143,25 @@ class Segments:
         )
         return restarts, position, offset
 
+    def leading(self, samples: IntArray, lookahead: int = 0) -> tuple[Restarts, IntArray, IntArray]:
+        """As ``covering``, but every segment from the first up to the last that holds one.
+
+        For a model whose states carry from segment to segment (``Model.chained``): the
+        runs before a sample are its history, and only the runs after the last sample
+        asked for can be left out. The last run ends ``lookahead`` samples after its last
+        sample asked for.
+        """
+        last = int(self.seg_of[samples].max()) + 1 if samples.size else 1
+        position = self.seg_of[samples].astype(np.int64)
+        offset = self.offset[samples]
+        lengths = np.minimum(self.lengths[:last] + lookahead, self.seg_of.size - self.starts[:last])
+        tail = int(offset[position == last - 1].max()) + 1 + lookahead if samples.size else 1
+        lengths[-1] = min(int(lengths[-1]), tail)
+        restarts = Restarts(
+            self.starts[:last], lengths, self.u_m, self.v_m_s, self.force_n, self.dial_slope
+        )
+        return restarts, position, offset
+
 
 def _filled(series: FloatArray) -> FloatArray:
     """Lost samples (NaN) linearly interpolated, so smoothing can run over them."""

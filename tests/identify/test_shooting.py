@@ -292,6 +292,38 @@ def test_a_fit_simulates_only_the_segments_it_scores_and_gets_the_same_outputs(
     assert restarts.lengths.sum() < 0.8 * tr.segments.lengths.sum()
 
 
+@pytest.mark.parametrize(
+    ("effects", "values"),
+    [
+        (("fibre_transverse_vibration",), {}),
+        (
+            ("stick_slip_friction", "channel_time_skew"),
+            {"channel_time_skew.force_skew_s": -0.0203},
+        ),
+    ],
+)
+def test_a_chained_model_runs_only_up_to_its_last_scored_sample(
+    stand: StandConfig, effects: tuple[str, ...], values: dict[str, float]
+) -> None:
+    # States carried from segment to segment make every earlier run part of a sample's
+    # history, but nothing after the last sample asked for (plus what an early channel
+    # reads ahead) can change it: the runs stop there, with the same outputs.
+    signal = SignalSpec(Shape.TRAPEZOIDAL, 0.025, 2.0, cycles=6, ramp_fraction=0.4)
+    tr, _ = _trace(stand, 3.096, [EffectSpec(e) for e in effects], signal=signal)
+    nominal = stand.stand_params("final", 3.096)
+    cand = Candidate.build(*effects)
+    assert cand.model(nominal, 3.096).chained
+    train = np.flatnonzero(tr.train)[::4]
+    samples = train[: train.size // 2]
+    full_u, full_f = simulate_values(cand, [dict(BASE, **values)], tr, nominal)
+    u, f = simulate_values(cand, [dict(BASE, **values)], tr, nominal, samples=samples)
+    np.testing.assert_array_equal(u, full_u[:, samples])
+    np.testing.assert_array_equal(f, full_f[:, samples])
+    restarts, _, _ = tr.segments.leading(samples)
+    assert restarts.starts[0] == 0
+    assert restarts.lengths.sum() < 0.7 * tr.segments.lengths.sum()
+
+
 def test_the_jacobian_reuses_the_residuals_least_squares_just_asked_for(
     stand: StandConfig,
 ) -> None:
