@@ -190,6 +190,7 @@ def simulate_segment_rows(
     lengths: NDArray[np.int64],
     init: FloatArray,
     substeps: int = DEFAULT_SUBSTEPS,
+    serial: bool = False,
 ) -> tuple[FloatArray, FloatArray]:
     """Many short runs from given states (multiple shooting), all in one parallel batch.
 
@@ -210,6 +211,9 @@ def simulate_segment_rows(
         segment starting at sample 0 starts from static rest instead.
     substeps
         RK4 steps per sample interval.
+    serial
+        Run on the calling thread without the GIL (several traces side by side, one
+        thread each) instead of on all cores.
 
     Returns
     -------
@@ -221,7 +225,8 @@ def simulate_segment_rows(
     sets, segs, width = rows2.shape[0], starts.shape[0], int(lengths.max())
     u, f = np.empty((sets, segs, width)), np.empty((sets, segs, width))
     knots, coef = friction_arrays(table)
-    kernel.simulate_segments_into(
+    run = kernel.simulate_segments_serial if serial else kernel.simulate_segments_into
+    run(
         np.ascontiguousarray(x_rel_m, dtype=np.float64), 1.0 / rate_hz, substeps, rows2,
         knots, coef, np.ascontiguousarray(starts, dtype=np.int64),
         np.ascontiguousarray(lengths, dtype=np.int64),

@@ -258,29 +258,48 @@ def simulate_segments_into(x, dt, substeps, params, knots, coef, starts, lens, i
     holds the last value to the end of the row (so a measurement transform over the
     padded row sees the run "held beyond its end").
     """
-    sets = params.shape[0]
     segs = starts.shape[0]
-    for flat in prange(sets * segs):
-        b = flat // segs
-        s = flat % segs
-        p = params[b]
-        n = lens[s]
-        xs = x[starts[s] : starts[s] + n]
-        u0, v0 = init[b, s, 0], init[b, s, 1]
-        scratch_v = np.empty(n)
-        ou = out_u[b, s]
-        ot = out_t[b, s]
-        if starts[s] == 0:  # from static rest, exactly as an open-loop run
-            simulate_into(xs, dt, substeps, p, knots, coef, ou, scratch_v, ot)
-        else:
-            ou[0] = u0
-            scratch_v[0] = v0
-            xd = (xs[1] - xs[0]) / dt if n > 1 else 0.0
-            delta = p[P_PRELOAD] + xs[0] - p[P_PROJ] * u0
-            t0 = p[P_STIFF] * delta + p[P_DAMP] * (xd - p[P_PROJ] * v0)
-            ot[0] = t0 if delta > 0.0 and t0 > 0.0 else 0.0
-            if n > 1:
-                advance_into(xs, dt, substeps, p, knots, coef, u0, v0, True, ou, scratch_v, ot)
-        for i in range(n, ou.shape[0]):
-            ou[i] = ou[n - 1]
-            ot[i] = ot[n - 1]
+    for flat in prange(params.shape[0] * segs):
+        _segment_into(
+            flat // segs, flat % segs, x, dt, substeps, params, knots, coef, starts, lens, init,
+            out_u, out_t,
+        )  # fmt: skip
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def simulate_segments_serial(  # type: ignore[no-untyped-def]
+    x, dt, substeps, params, knots, coef, starts, lens, init, out_u, out_t
+):
+    """``simulate_segments_into`` on the calling thread, without the GIL (traces side by side)."""
+    segs = starts.shape[0]
+    for flat in range(params.shape[0] * segs):
+        _segment_into(
+            flat // segs, flat % segs, x, dt, substeps, params, knots, coef, starts, lens, init,
+            out_u, out_t,
+        )  # fmt: skip
+
+
+@njit(cache=True, error_model="numpy")
+def _segment_into(b, s, x, dt, substeps, params, knots, coef, starts, lens, init, out_u, out_t):  # type: ignore[no-untyped-def]
+    """Segment s of set b of ``simulate_segments_into``."""
+    p = params[b]
+    n = lens[s]
+    xs = x[starts[s] : starts[s] + n]
+    u0, v0 = init[b, s, 0], init[b, s, 1]
+    scratch_v = np.empty(n)
+    ou = out_u[b, s]
+    ot = out_t[b, s]
+    if starts[s] == 0:  # from static rest, exactly as an open-loop run
+        simulate_into(xs, dt, substeps, p, knots, coef, ou, scratch_v, ot)
+    else:
+        ou[0] = u0
+        scratch_v[0] = v0
+        xd = (xs[1] - xs[0]) / dt if n > 1 else 0.0
+        delta = p[P_PRELOAD] + xs[0] - p[P_PROJ] * u0
+        t0 = p[P_STIFF] * delta + p[P_DAMP] * (xd - p[P_PROJ] * v0)
+        ot[0] = t0 if delta > 0.0 and t0 > 0.0 else 0.0
+        if n > 1:
+            advance_into(xs, dt, substeps, p, knots, coef, u0, v0, True, ou, scratch_v, ot)
+    for i in range(n, ou.shape[0]):
+        ou[i] = ou[n - 1]
+        ot[i] = ot[n - 1]

@@ -231,11 +231,14 @@ class Model:
         rate_hz: float,
         restarts: Restarts,
         variants: Sequence[Variant] = ({},),
+        serial: bool = False,
     ) -> tuple[FloatArray, FloatArray]:
         """Multiple shooting: short runs restarted from measured states, in parallel.
 
         Returns the recorded u (m) and F (N) of every segment run, shape (sets,
         segments, longest segment), each segment's last value held past its end.
+        ``serial``: the runs on the calling thread, without the GIL, so that several
+        traces can run side by side (one thread each) instead of each on all cores.
         """
         x_rel = check_input(x_m, rate_hz)
         base, rows = self._rows(variants, augmented=True)  # the start states need them
@@ -248,10 +251,10 @@ class Model:
         if self.physical:
             return _augmented.simulate_augmented_segments(
                 x_rel, rate_hz, rows, table, starts, lengths, init, self.substeps,
-                chained=self.chained,
+                chained=self.chained, serial=serial,
             )  # fmt: skip
         u, f = _baseline.simulate_segment_rows(
-            x_rel, rate_hz, base, table, starts, lengths, init[:, :, :2], self.substeps
+            x_rel, rate_hz, base, table, starts, lengths, init[:, :, :2], self.substeps, serial
         )
         if self.measured:
             return _augmented.measure_segments(u, f, rate_hz, rows, starts, init)

@@ -207,6 +207,7 @@ def simulate_augmented_segments(
     init: FloatArray,
     substeps: int = DEFAULT_SUBSTEPS,
     chained: bool = False,
+    serial: bool = False,
 ) -> tuple[FloatArray, FloatArray]:
     """Multiple shooting: many short runs of many rows from measured states, in parallel.
 
@@ -216,7 +217,8 @@ def simulate_augmented_segments(
     string modes, bristles and the pulley seat carry over from the previous segment's
     run when ``chained``. Returns the *recorded* u (m) and F (N), shape (sets, segments,
     max length), each segment measured on its own (``measure_segments``), last value
-    held past its end.
+    held past its end. ``serial``: on the calling thread, without the GIL (several
+    traces side by side) instead of on all cores.
     """
     rows2 = np.ascontiguousarray(np.atleast_2d(rows), dtype=np.float64)
     sets, segs, width = rows2.shape[0], starts.shape[0], int(lengths.max())
@@ -225,7 +227,10 @@ def simulate_augmented_segments(
     # ``chained``: string modes, bristles and the pulley seat carry over between
     # segments (see simulate_chained_into); the model decides.
     k = _kernel(rows2)
-    kernel = k.simulate_chained_into if chained else k.simulate_segments_into
+    if serial:
+        kernel = k.simulate_chained_serial if chained else k.simulate_segments_serial
+    else:
+        kernel = k.simulate_chained_into if chained else k.simulate_segments_into
     kernel(
         np.ascontiguousarray(x_rel_m, dtype=np.float64), 1.0 / rate_hz, substeps, rows2,
         knots, coef, np.ascontiguousarray(starts, dtype=np.int64),

@@ -19,6 +19,7 @@ import inspect
 import os
 import sys
 import tempfile
+import threading
 from functools import cache
 from pathlib import Path
 from types import ModuleType
@@ -38,7 +39,11 @@ def kernel_for(added: tuple[EffectInfo, ...]) -> ModuleType:
     """The kernel module for rows with these added effects on (the kernel if none)."""
     if not added:
         return ek
-    return _composed(tuple(sorted(added, key=lambda info: info.flag_column)))
+    with _COMPOSING:  # traces run side by side: one thread writes and imports it
+        return _composed(tuple(sorted(added, key=lambda info: info.flag_column)))
+
+
+_COMPOSING = threading.Lock()
 
 
 def cache_dir() -> Path:

@@ -829,51 +829,61 @@ def simulate_chained_into(x, dt, substeps, rows, knots, coef, starts, lens, init
     at that sample; everything else starts from ``measured_state`` as before (the pulley
     seat from the recorded slack episodes, ``measured_seats``).
     """
-    sets = rows.shape[0]
+    for b in prange(rows.shape[0]):
+        _chain_into(b, x, dt, substeps, rows, knots, coef, starts, lens, init, out_u, out_t1)
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def simulate_chained_serial(x, dt, substeps, rows, knots, coef, starts, lens, init, out_u, out_t1):  # type: ignore[no-untyped-def]
+    """``simulate_chained_into`` on the calling thread, without the GIL (traces side by side)."""
+    for b in range(rows.shape[0]):
+        _chain_into(b, x, dt, substeps, rows, knots, coef, starts, lens, init, out_u, out_t1)
+
+
+@njit(cache=True, error_model="numpy")
+def _chain_into(b, x, dt, substeps, rows, knots, coef, starts, lens, init, out_u, out_t1):  # type: ignore[no-untyped-def]
+    """Row b of ``simulate_chained_into``: its segments one after the other."""
     segs = starts.shape[0]
-    for b in prange(sets):
-        carried = np.zeros(NY - Y_A1)
-        have = False
-        for s in range(segs):
-            n = lens[s]
-            xs = x[starts[s] : starts[s] + n]
-            ou, ot = out_u[b, s], out_t1[b, s]
-            sv, st2 = np.empty(n), np.empty(n)
-            c = pack(rows[b], knots, coef)
-            xd = (xs[1] - xs[0]) / dt if n > 1 else 0.0
-            if starts[s] == 0:
-                y = rest_state(c)
-                ou[0], sv[0] = y[Y_U], y[Y_V]
-                ot[0] = c[D_K1] * (c[D_D10] + xs[0])
-                st2[0] = ot[0]
-            else:
-                y = measured_state(c, xs[0], xd, init[b, s])
-                if have:
-                    y = (
-                        y[0], y[1], y[2], y[3], y[4], y[5],
-                        carried[0], carried[1], carried[2], carried[3], carried[4],
-                    )  # fmt: skip
-                _set_taut(c, y, xs[0], xd)
-                _sample_out(c, y, xs[0], xd, 0, ou, sv, ot, st2)
-            state = np.empty(NY)
-            for k in range(NY):
-                state[k] = y[k]
-            hand = starts[s + 1] - starts[s] if s + 1 < segs else n
-            if 0 < hand < n:
-                h1 = hand + 1
-                advance_into(xs[:h1], dt, substeps, c, state, ou[:h1], sv[:h1], ot[:h1], st2[:h1])
-                for k in range(NY - Y_A1):
-                    carried[k] = state[Y_A1 + k]
-                have = True
-                tail = slice(hand, n)
-                advance_into(
-                    xs[tail], dt, substeps, c, state, ou[tail], sv[tail], ot[tail], st2[tail]
-                )
-            elif n > 1:
-                advance_into(xs, dt, substeps, c, state, ou, sv, ot, st2)
-            for i in range(n, ou.shape[0]):
-                ou[i] = ou[n - 1]
-                ot[i] = ot[n - 1]
+    carried = np.zeros(NY - Y_A1)
+    have = False
+    for s in range(segs):
+        n = lens[s]
+        xs = x[starts[s] : starts[s] + n]
+        ou, ot = out_u[b, s], out_t1[b, s]
+        sv, st2 = np.empty(n), np.empty(n)
+        c = pack(rows[b], knots, coef)
+        xd = (xs[1] - xs[0]) / dt if n > 1 else 0.0
+        if starts[s] == 0:
+            y = rest_state(c)
+            ou[0], sv[0] = y[Y_U], y[Y_V]
+            ot[0] = c[D_K1] * (c[D_D10] + xs[0])
+            st2[0] = ot[0]
+        else:
+            y = measured_state(c, xs[0], xd, init[b, s])
+            if have:
+                y = (
+                    y[0], y[1], y[2], y[3], y[4], y[5],
+                    carried[0], carried[1], carried[2], carried[3], carried[4],
+                )  # fmt: skip
+            _set_taut(c, y, xs[0], xd)
+            _sample_out(c, y, xs[0], xd, 0, ou, sv, ot, st2)
+        state = np.empty(NY)
+        for k in range(NY):
+            state[k] = y[k]
+        hand = starts[s + 1] - starts[s] if s + 1 < segs else n
+        if 0 < hand < n:
+            h1 = hand + 1
+            advance_into(xs[:h1], dt, substeps, c, state, ou[:h1], sv[:h1], ot[:h1], st2[:h1])
+            for k in range(NY - Y_A1):
+                carried[k] = state[Y_A1 + k]
+            have = True
+            tail = slice(hand, n)
+            advance_into(xs[tail], dt, substeps, c, state, ou[tail], sv[tail], ot[tail], st2[tail])
+        elif n > 1:
+            advance_into(xs, dt, substeps, c, state, ou, sv, ot, st2)
+        for i in range(n, ou.shape[0]):
+            ou[i] = ou[n - 1]
+            ot[i] = ot[n - 1]
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
@@ -885,29 +895,46 @@ def simulate_segments_into(x, dt, substeps, rows, knots, coef, starts, lens, ini
     from ``measured_state`` of init[b, s] (columns I_*). Writes u and the drive-side
     tension into out_*[b, s, :lens[s]], the last value held to the end of the row.
     """
-    sets = rows.shape[0]
     segs = starts.shape[0]
-    for flat in prange(sets * segs):
-        b = flat // segs
-        s = flat % segs
-        n = lens[s]
-        xs = x[starts[s] : starts[s] + n]
-        ou = out_u[b, s]
-        ot = out_t1[b, s]
-        sv, st2 = np.empty(n), np.empty(n)
-        if starts[s] == 0:
-            simulate_into(xs, dt, substeps, rows[b], knots, coef, ou, sv, ot, st2)
-        else:
-            c = pack(rows[b], knots, coef)
-            xd = (xs[1] - xs[0]) / dt if n > 1 else 0.0
-            y = measured_state(c, xs[0], xd, init[b, s])
-            _set_taut(c, y, xs[0], xd)
-            _sample_out(c, y, xs[0], xd, 0, ou, sv, ot, st2)
-            state = np.empty(NY)
-            for k in range(NY):
-                state[k] = y[k]
-            if n > 1:
-                advance_into(xs, dt, substeps, c, state, ou, sv, ot, st2)
-        for i in range(n, ou.shape[0]):
-            ou[i] = ou[n - 1]
-            ot[i] = ot[n - 1]
+    for flat in prange(rows.shape[0] * segs):
+        _segment_into(
+            flat // segs, flat % segs, x, dt, substeps, rows, knots, coef, starts, lens, init,
+            out_u, out_t1,
+        )  # fmt: skip
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def simulate_segments_serial(x, dt, substeps, rows, knots, coef, starts, lens, init, out_u, out_t1):  # type: ignore[no-untyped-def]
+    """``simulate_segments_into`` on the calling thread, without the GIL (traces side by side)."""
+    segs = starts.shape[0]
+    for flat in range(rows.shape[0] * segs):
+        _segment_into(
+            flat // segs, flat % segs, x, dt, substeps, rows, knots, coef, starts, lens, init,
+            out_u, out_t1,
+        )  # fmt: skip
+
+
+@njit(cache=True, error_model="numpy")
+def _segment_into(b, s, x, dt, substeps, rows, knots, coef, starts, lens, init, out_u, out_t1):  # type: ignore[no-untyped-def]
+    """Segment s of row b of ``simulate_segments_into``."""
+    n = lens[s]
+    xs = x[starts[s] : starts[s] + n]
+    ou = out_u[b, s]
+    ot = out_t1[b, s]
+    sv, st2 = np.empty(n), np.empty(n)
+    if starts[s] == 0:
+        simulate_into(xs, dt, substeps, rows[b], knots, coef, ou, sv, ot, st2)
+    else:
+        c = pack(rows[b], knots, coef)
+        xd = (xs[1] - xs[0]) / dt if n > 1 else 0.0
+        y = measured_state(c, xs[0], xd, init[b, s])
+        _set_taut(c, y, xs[0], xd)
+        _sample_out(c, y, xs[0], xd, 0, ou, sv, ot, st2)
+        state = np.empty(NY)
+        for k in range(NY):
+            state[k] = y[k]
+        if n > 1:
+            advance_into(xs, dt, substeps, c, state, ou, sv, ot, st2)
+    for i in range(n, ou.shape[0]):
+        ou[i] = ou[n - 1]
+        ot[i] = ot[n - 1]

@@ -26,6 +26,7 @@ from numpy.typing import NDArray
 from scipy.optimize import least_squares
 
 from sim.effects import EFFECTS, EffectSpec, ParamInfo
+from sim.identify.side_by_side import side_by_side
 from sim.identify.traces import Trace
 from sim.model import Model, Variant
 from sim.params import StandParams
@@ -193,6 +194,7 @@ def simulate_values(
     nominal: StandParams,
     shooting: bool = True,
     samples: IntArray | None = None,
+    serial: bool = False,
 ) -> tuple[FloatArray, FloatArray]:
     """Recorded-channel outputs u (m), F (N) of a candidate for many value sets, in parallel.
 
@@ -201,7 +203,8 @@ def simulate_values(
     loop from rest over the whole trace (chaotic for the light weight in quick motions).
     ``samples``: only the outputs at these samples (sets, len(samples)), simulating only
     the segments that hold them (all up to the last of them if the model carries states
-    from segment to segment).
+    from segment to segment). ``serial``: the shooting runs on the calling thread
+    (``side_by_side``).
     """
     model = candidate.model(nominal, trace.mass_kg)
     variants = [candidate.variant(nominal, v) for v in values]
@@ -215,12 +218,12 @@ def simulate_values(
             restarts, position, offset = seg.leading(samples, ahead + 1 if ahead else 0)
         else:
             restarts, position, offset = seg.covering(samples, ahead + 1)
-        u, f = model.run_segments(trace.x_m, trace.rate_hz, restarts, variants)
+        u, f = model.run_segments(trace.x_m, trace.rate_hz, restarts, variants, serial)
         return u[:, position, offset], f[:, position, offset]
     else:
         seg = trace.segments
         restarts = seg.restarts_ahead(ahead + 1 if ahead else 0)
-        u, f = model.run_segments(trace.x_m, trace.rate_hz, restarts, variants)
+        u, f = model.run_segments(trace.x_m, trace.rate_hz, restarts, variants, serial)
         u, f = seg.assemble(u), seg.assemble(f)
     return (u, f) if samples is None else (u[:, samples], f[:, samples])
 
@@ -259,22 +262,27 @@ class Objective:
             idx = idx[: max(1, math.ceil(share * idx.size))]
             self._masks.append((idx, channel_spread(tr.u_m, idx), channel_spread(tr.force_n, idx)))
 
-    def outputs(
-        self, zs: FloatArray, trace: Trace, samples: IntArray
-    ) -> tuple[FloatArray, FloatArray]:
-        """Simulated recorded u (m) and F (N) at ``samples`` for parameter vectors zs."""
-        self.simulations += len(zs)
-        values = [self.candidate.natural(z) for z in zs]
-        return simulate_values(self.candidate, values, trace, self.nominal, samples=samples)
-
     def residuals_batch(self, zs: FloatArray) -> FloatArray:
-        """Residual vectors for many parameter vectors at once, shape (sets, residuals)."""
-        parts = []
-        for tr, (idx, su, sf) in zip(self.traces, self._masks, strict=True):
-            u, f = self.outputs(zs, tr, idx)
-            parts.append((u - tr.u_m[idx]) / su)
-            parts.append((f - tr.force_n[idx]) / sf)
-        out = np.concatenate(parts, axis=1)
+        """Residual vectors for many parameter vectors at once, shape (sets, residuals).
+
+        One parameter set runs the traces side by side (``side_by_side``).
+        """
+        values = [self.candidate.natural(z) for z in zs]
+        self.simulations += len(zs) * len(self.traces)
+
+        def trace_residuals(k: int, serial: bool) -> list[FloatArray]:
+            tr, (idx, su, sf) = self.traces[k], self._masks[k]
+            u, f = simulate_values(
+                self.candidate, values, tr, self.nominal, samples=idx, serial=serial
+            )
+            return [(u - tr.u_m[idx]) / su, (f - tr.force_n[idx]) / sf]
+
+        if len(zs) == 1:
+            sizes = [int(idx[-1]) for idx, _, _ in self._masks]
+            per_trace = side_by_side(trace_residuals, sizes)
+        else:
+            per_trace = [trace_residuals(k, False) for k in range(len(self.traces))]
+        out = np.concatenate([part for parts in per_trace for part in parts], axis=1)
         return np.where(np.isfinite(out), out, 1e3)  # a diverged run is simply very bad
 
     def residuals(self, z: FloatArray) -> FloatArray:

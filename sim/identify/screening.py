@@ -23,6 +23,7 @@ from sim.identify.fitting import (
     simulate_values,
 )
 from sim.identify.heldout import Outputs
+from sim.identify.side_by_side import side_by_side
 from sim.identify.traces import Trace
 from sim.params import StandParams
 
@@ -32,12 +33,17 @@ FloatArray = NDArray[np.float64]
 def outputs_of(
     candidate: Candidate, values: dict[str, float], traces: Sequence[Trace], nominal: StandParams
 ) -> list[Outputs]:
-    """The candidate's recorded-channel outputs at one set of values, trace by trace."""
-    outs = []
-    for tr in traces:
-        u, f = simulate_values(candidate, [values], tr, nominal)
-        outs.append(Outputs(u[0], f[0]))
-    return outs
+    """The candidate's recorded-channel outputs at one set of values, trace by trace.
+
+    The traces run side by side (``side_by_side``): one set is too small a batch to
+    fill the cores within a trace.
+    """
+
+    def trace_outputs(k: int, serial: bool) -> Outputs:
+        u, f = simulate_values(candidate, [values], traces[k], nominal, serial=serial)
+        return Outputs(u[0], f[0])
+
+    return side_by_side(trace_outputs, [tr.samples for tr in traces])
 
 
 def probe_values(effect: str, baseline: dict[str, float]) -> list[dict[str, float]]:

@@ -324,6 +324,47 @@ def test_a_chained_model_runs_only_up_to_its_last_scored_sample(
     assert restarts.lengths.sum() < 0.7 * tr.segments.lengths.sum()
 
 
+@pytest.mark.parametrize(
+    "effects",
+    [(), ("fibre_viscoelastic",), ("stick_slip_friction",), ("side_load_friction",)],
+)
+def test_the_serial_kernels_give_the_parallel_kernels_outputs_bit_for_bit(
+    stand: StandConfig, effects: tuple[str, ...]
+) -> None:
+    # The traces of a one-set evaluation run side by side on the kernels' serial
+    # variants: every (set, segment) item must come out as the parallel kernel computes
+    # it (the baseline's kernel, the effects' kernel, the chained kernel).
+    tr, _ = _trace(stand, 3.096, [EffectSpec(e) for e in effects])
+    nominal = stand.stand_params("final", 3.096)
+    cand = Candidate.build(*effects)
+    sets = [dict(BASE), dict(BASE, stiffness_scale=1.2, friction_scale=0.7)]
+    sets[1].update({p.name: p.to_natural(sum(p.bounds()) / 2) for p in cand.params[3:]})
+    samples = np.flatnonzero(tr.train)[::4]
+    for kw in ({}, {"samples": samples}):
+        parallel = simulate_values(cand, sets, tr, nominal, **kw)  # type: ignore[arg-type]
+        serial = simulate_values(cand, sets, tr, nominal, serial=True, **kw)  # type: ignore[arg-type]
+        np.testing.assert_array_equal(serial[0], parallel[0])
+        np.testing.assert_array_equal(serial[1], parallel[1])
+
+
+def test_side_by_side_runs_items_in_threads_and_keeps_their_order() -> None:
+    import threading
+
+    import numba
+
+    from sim.identify.side_by_side import side_by_side
+
+    def work(k: int, serial: bool) -> tuple[int, bool, str]:
+        return k, serial, threading.current_thread().name
+
+    results = side_by_side(work, [1, 5, 3])
+    assert [r[0] for r in results] == [0, 1, 2]
+    threaded = numba.get_num_threads() > 1
+    assert all(r[1] is threaded for r in results)
+    assert all(r[2].startswith("trace") is threaded for r in results)
+    assert side_by_side(work, [4]) == [(0, False, threading.current_thread().name)]
+
+
 def test_the_jacobian_reuses_the_residuals_least_squares_just_asked_for(
     stand: StandConfig,
 ) -> None:

@@ -1,0 +1,44 @@
+"""One parameter set over several traces: the traces side by side, one thread each.
+
+A batch of many parameter sets fills the cores within each trace (every set and segment
+is a work item). A single set does not: the slow recording, never slack, is one segment
+on one core, and a model whose states carry from segment to segment runs its whole trace
+on one core. Run one after the other, the traces then leave a core idle most of the
+time. Side by side, each trace runs on its own thread through the kernels' serial
+GIL-free variants (``serial=True``), the longest first; the outputs are bit for bit those
+of the parallel kernels, which compute every item alike.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from concurrent.futures import ThreadPoolExecutor
+from functools import cache
+from typing import TypeVar
+
+import numba
+
+T = TypeVar("T")
+
+__all__ = ["side_by_side"]
+
+
+@cache
+def _pool(threads: int) -> ThreadPoolExecutor:
+    return ThreadPoolExecutor(max_workers=threads, thread_name_prefix="trace")
+
+
+def side_by_side(work: Callable[[int, bool], T], sizes: Sequence[int]) -> list[T]:
+    """``work(k, serial)`` for every item k (``sizes[k]``: its cost), results in order.
+
+    With more than one numba thread and more than one item, the items run in threads
+    (largest first) with ``serial`` True; otherwise one after the other with ``serial``
+    False (on all cores each).
+    """
+    threads = min(len(sizes), numba.get_num_threads())
+    if threads < 2:
+        return [work(k, False) for k in range(len(sizes))]
+    pool = _pool(threads)
+    order = sorted(range(len(sizes)), key=lambda k: -sizes[k])
+    futures = {k: pool.submit(work, k, True) for k in order}
+    return [futures[k].result() for k in range(len(sizes))]
