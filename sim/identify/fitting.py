@@ -247,9 +247,7 @@ class Objective:
         traces: Sequence[Trace],
         nominal: StandParams,
         stride: int = 4,
-        share: float = 1.0,
     ) -> None:
-        """``share``: score only this leading share of each trace's training samples."""
         self.candidate = candidate
         self.traces = list(traces)
         self.nominal = nominal
@@ -259,7 +257,6 @@ class Objective:
         self._masks = []
         for tr in self.traces:
             idx = scored_samples(tr, stride)
-            idx = idx[: max(1, math.ceil(share * idx.size))]
             self._masks.append((idx, channel_spread(tr.u_m, idx), channel_spread(tr.force_n, idx)))
 
     def residuals_batch(self, zs: FloatArray) -> FloatArray:
@@ -343,12 +340,6 @@ def _grid_starts(objective: Objective) -> list[FloatArray]:
 #: parameters (plus one level on each side out to the physical bounds: at most 4³ = 64
 #: points, one batch).
 EFFECT_GRID_LEVELS = {1: 8, 2: 5, 3: 2}
-#: A start grid larger than this is raced: every point on the leading ``RACE_SHARE`` of
-#: each trace's training samples, then the ``RACE_FINALISTS`` best (and the points the
-#: recordings or fits show, ``extra``) on all of them.
-RACE_ABOVE = 16
-RACE_SHARE = 0.5
-RACE_FINALISTS = 6
 
 
 def grid_axis(p: FreeParam, levels: int) -> FloatArray:
@@ -388,9 +379,6 @@ def effect_grid_start(
     fit needs a start in the right basin: spread evenly over the physical ranges, which
     are decades wider, the grid lost a light-weight Maxwell branch (τ 0.08 s; the grid's
     τ levels 0.08 s apart by a factor 3.5, the refit stuck at 0.29 s).
-
-    A large grid is raced (``RACE_ABOVE``): a basin shows in half of the training cycles
-    as well as in all of them, and only the best few points need the whole cost.
     """
     objective = Objective(candidate, traces, nominal, stride)
     own = [p for p in candidate.params if p.name not in baseline]
@@ -402,10 +390,6 @@ def effect_grid_start(
         z = dict(base)
         z.update({p.name: float(v) for p, v in zip(own, combo, strict=True)})
         points.append(np.array([z[p.name] for p in candidate.params]))
-    if len(points) > RACE_ABOVE:
-        part = Objective(candidate, traces, nominal, stride, share=RACE_SHARE)
-        heats = np.sum(part.residuals_batch(np.stack(points)) ** 2, axis=1)
-        points = [points[i] for i in np.argsort(heats, kind="stable")[:RACE_FINALISTS]]
     for values in extra:
         merged = {**baseline, **values}
         points.append(

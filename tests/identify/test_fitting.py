@@ -1,4 +1,4 @@
-"""The fits' search: how a short refit stops, and how a large start grid is raced."""
+"""The fits' search: how a short refit stops."""
 
 from __future__ import annotations
 
@@ -7,14 +7,12 @@ import dataclasses
 import numpy as np
 import pytest
 
-import sim.identify.fitting as fitting
 from sim.config import default_config
 from sim.identify.check import CaseSpec, make_campaign
 from sim.identify.diagnose import REFIT_FTOL
 from sim.identify.fitting import Candidate, Objective, effect_grid_start, fit
 from sim.identify.shooting import dial_slope
 from sim.identify.traces import Trace
-from sim.model import Model
 from sim.params import StandParams
 
 EFFECT = "fibre_viscoelastic"
@@ -52,33 +50,3 @@ def test_a_refit_stops_once_a_step_gains_little_and_keeps_its_cost(
     assert runs[1].evaluations < runs[0].evaluations
     assert runs[1].train_cost <= 1.005 * runs[0].train_cost
     assert runs[1].train_cost < _cost(cand, traces, nominal, start)
-
-
-def test_a_large_start_grid_raced_on_half_the_cycles_finds_the_whole_grids_basin(
-    campaign: tuple[list[Trace], StandParams, dict[str, float]],
-    monkeypatch: pytest.MonkeyPatch,
-) -> None:
-    # The branch's 7 × 7 grid scored on the leading half of the training samples, its
-    # best six on all: the start it picks costs (on all samples) what the exhaustive
-    # grid's best costs, within a few percent, for little more than half the simulated
-    # samples.
-    traces, nominal, _ = campaign
-    cand = Candidate.build(EFFECT)
-    base = fit(Candidate.build(), traces, nominal)
-    simulated: list[int] = []
-    real = Model.run_segments
-
-    def counted(self: Model, x_m, rate_hz, restarts, variants=({},)):  # type: ignore[no-untyped-def]
-        simulated.append(int(restarts.lengths.sum()) * len(variants))
-        return real(self, x_m, rate_hz, restarts, variants)
-
-    monkeypatch.setattr(Model, "run_segments", counted)
-    raced = effect_grid_start(cand, traces, nominal, base.values)
-    raced_work = sum(simulated)
-    simulated.clear()
-    monkeypatch.setattr(fitting, "RACE_ABOVE", 10**6)
-    exhaustive = effect_grid_start(cand, traces, nominal, base.values)
-    exhaustive_work = sum(simulated)
-    assert raced_work < 0.65 * exhaustive_work
-    full = _cost(cand, traces, nominal, exhaustive)
-    assert _cost(cand, traces, nominal, raced) <= 1.03 * full
