@@ -242,11 +242,7 @@ class Objective:
     """Residuals of a candidate over traces; simulations batched across parameter sets."""
 
     def __init__(
-        self,
-        candidate: Candidate,
-        traces: Sequence[Trace],
-        nominal: StandParams,
-        stride: int = 4,
+        self, candidate: Candidate, traces: Sequence[Trace], nominal: StandParams, stride: int = 4
     ) -> None:
         self.candidate = candidate
         self.traces = list(traces)
@@ -275,7 +271,7 @@ class Objective:
             return [(u - tr.u_m[idx]) / su, (f - tr.force_n[idx]) / sf]
 
         if len(zs) == 1:
-            sizes = [int(idx[-1]) for idx, _, _ in self._masks]
+            sizes = [int(idx[-1]) if idx.size else 0 for idx, _, _ in self._masks]
             per_trace = side_by_side(trace_residuals, sizes)
         else:
             per_trace = [trace_residuals(k, False) for k in range(len(self.traces))]
