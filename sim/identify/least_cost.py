@@ -3,8 +3,8 @@
 A fit's cost is a sum over traces of sums of squares, so a point's cost on some of the
 traces bounds its total from below. Once that partial cost exceeds the total of a point
 already scored in full, the point cannot be the grid's best and its other traces need
-not run (branch and bound). The answer is the plain grid's: the same point, ties to the
-lower index. Unlike racing on part of the samples (which dropped a skew's basin that
+not run (branch and bound). The answer is the plain grid's: the same point (the sums'
+rounding aside), ties to the lower index. Unlike racing on part of the samples (which dropped a skew's basin that
 shows only over a whole recording), nothing is dropped on a guess.
 
 Measured on three validation campaigns' grids (docs/diagnosis.md, "Time"): the pulley
@@ -50,7 +50,7 @@ def least_cost_point(
         total[leaders] += trace_costs[k](points[leaders])
     bar = float(total[leaders].min())
     # ``<=``: a point tied with the bar stays, so ties still go to the lower index.
-    rest = np.array([i for i in range(n) if i not in set(leaders) and partial[i] <= bar], int)
+    rest = np.setdiff1d(np.flatnonzero(partial <= bar), leaders)
     for k in order[1:]:
         if rest.size == 0:
             break
