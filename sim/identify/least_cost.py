@@ -4,8 +4,9 @@ A fit's cost is a sum over traces of sums of squares, so a point's cost on some 
 traces bounds its total from below. Once that partial cost exceeds the total of a point
 already scored in full, the point cannot be the grid's best and its other traces need
 not run (branch and bound). The answer is the plain grid's: the same point (the sums'
-rounding aside), ties to the lower index. Unlike racing on part of the samples (which dropped a skew's basin that
-shows only over a whole recording), nothing is dropped on a guess.
+rounding aside), ties to the lower index. Unlike racing on part of the samples (which
+dropped a skew's basin that shows only over a whole recording), nothing is dropped on a
+guess.
 
 Measured on three validation campaigns' grids (docs/diagnosis.md, "Time"): the pulley
 inertia's and the Maxwell branch's grids need 0.4–0.6 of the simulated samples, the
