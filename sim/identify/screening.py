@@ -3,8 +3,8 @@
 Each effect's output change at a few probe magnitudes (its typical range), projected off
 the baseline parameters' directions; the share of the baseline's residual that direction
 explains orders the candidates and gives each refit one more start point. A few
-simulations per effect. The same test on top of an accepted effect (its fit as the base)
-orders the candidates for a second one.
+simulations per effect (one batch each). The same test on top of an accepted effect (its
+fit as the base) orders the candidates for a second one.
 """
 
 from __future__ import annotations
@@ -72,29 +72,33 @@ def probe_values(effect: str, baseline: dict[str, float]) -> list[dict[str, floa
     return probes
 
 
-def _stack(traces: Sequence[Trace], outs: Sequence[Outputs], scored: bool = False) -> FloatArray:
-    """Normalised training-sample vector of outputs (u and F per trace).
-
-    ``outs`` hold every sample, or with ``scored`` only the compared ones
-    (``scored_samples``).
-    """
+def _stack(traces: Sequence[Trace], outs: Sequence[Outputs]) -> FloatArray:
+    """Normalised training-sample vector of outputs (u and F per trace, every sample)."""
     parts = []
     for tr, o in zip(traces, outs, strict=True):
         idx = scored_samples(tr)
         for rec, sim in ((tr.u_m, o.u_m), (tr.force_n, o.force_n)):
-            parts.append((sim if scored else sim[idx]) / channel_spread(rec, idx))
+            parts.append(sim[idx] / channel_spread(rec, idx))
     return np.concatenate(parts)
 
 
-def _stack_of(
-    candidate: Candidate, values: dict[str, float], traces: Sequence[Trace], nominal: StandParams
+def _stacks_of(
+    candidate: Candidate,
+    value_sets: Sequence[dict[str, float]],
+    traces: Sequence[Trace],
+    nominal: StandParams,
 ) -> FloatArray:
-    """``_stack`` of a candidate's outputs, simulating only what the score test compares."""
-    outs = []
+    """``_stack`` of a candidate's outputs for many value sets, shape (sets, samples).
+
+    One batch per trace (the sets fill the cores), simulating only what the score test
+    compares.
+    """
+    parts = []
     for tr in traces:
-        u, f = simulate_values(candidate, [values], tr, nominal, samples=scored_samples(tr))
-        outs.append(Outputs(u[0], f[0]))
-    return _stack(traces, outs, scored=True)
+        idx = scored_samples(tr)
+        u, f = simulate_values(candidate, value_sets, tr, nominal, samples=idx)
+        parts += [u / channel_spread(tr.u_m, idx), f / channel_spread(tr.force_n, idx)]
+    return np.concatenate(parts, axis=1)
 
 
 def screen(
@@ -111,27 +115,29 @@ def screen(
     # Baseline parameters' directions (forward differences), to project off. Thresholds
     # and counts (``scan``) have no direction: the output is a step function of them.
     base_cand = base_fit.candidate
-    cols = []
+    bumps = []
     for p in base_cand.params:
         if p.scan:
             continue
         bumped = dict(base_fit.values)
         bumped[p.name] = base_fit.values[p.name] * 1.01 if base_fit.values[p.name] else 0.01
-        cols.append(_stack_of(base_cand, bumped, traces, nominal) - y_base)
-    jb = np.stack(cols, axis=1)
+        bumps.append(bumped)
+    jb = (_stacks_of(base_cand, bumps, traces, nominal) - y_base).T
     q, _ = np.linalg.qr(jb)
     r_perp = r - q @ (q.T @ r)
     r2 = float(r_perp @ r_perp) or 1e-300
     scores: dict[str, float] = {}
     best_probe: dict[str, dict[str, float]] = {}
-    sims = len(cols)
+    sims = len(bumps)
     for effect in effects:
         # On top of the effects the base fit already has (none for the baseline).
         cand = Candidate.build(*base_cand.effects, effect)
         best = 0.0
-        for values in probe_values(effect, base_fit.values):
-            d = _stack_of(cand, values, traces, nominal) - y_base
-            sims += 1
+        probes = probe_values(effect, base_fit.values)
+        changes = _stacks_of(cand, probes, traces, nominal) - y_base
+        sims += len(probes)
+        for values, change in zip(probes, changes, strict=True):
+            d = change.copy()  # its own buffer: BLAS rounds by alignment (bit-identical)
             d_perp = d - q @ (q.T @ d)
             denom = float(d_perp @ d_perp)
             a = float(d_perp @ r_perp) / denom if denom > 0 else 0.0

@@ -489,6 +489,25 @@ def test_screening_on_top_of_a_pulley_jump_leaves_its_thresholds_and_count_alone
     assert all(0.0 <= s <= 1.0 for s in scores.values())
 
 
+@pytest.mark.parametrize("effect", ["channel_time_skew", "fibre_viscoelastic"])
+def test_screenings_probes_in_one_batch_give_each_probe_alone_bit_for_bit(
+    stand: StandConfig, effect: str
+) -> None:
+    # The score test simulates an effect's probes as one batch per trace. A batch runs
+    # every row as far as its most-ahead row reads (a skew's probes: early channels of
+    # both signs), and no row may see another's.
+    from sim.identify.screening import _stacks_of, probe_values
+
+    tr, _ = _trace(stand, 3.096, [EffectSpec(effect, {})])
+    nominal = stand.stand_params("final", 3.096)
+    candidate = Candidate.build(effect)
+    probes = probe_values(effect, dict(BASE))
+    batch = _stacks_of(candidate, probes, [tr, tr], nominal)
+    alone = np.stack([_stacks_of(candidate, [p], [tr, tr], nominal)[0] for p in probes])
+    assert len(probes) >= 3
+    assert np.array_equal(batch, alone)
+
+
 @pytest.mark.parametrize(
     "params",
     [
