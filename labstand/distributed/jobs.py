@@ -109,11 +109,14 @@ def run_jobs(
             progress.close()
         return [results[i] for i in range(len(items))]
     run_id = uuid.uuid4().hex[:8]
-    futures = [
-        client.submit(call_job, fn, item, threads, key=f"labstand-{run_id}-{i}", pure=False)
-        for i, item in enumerate(items)
-    ]
+    with remembered_interrupt(raise_now=False) as submitting:  # every future whole
+        futures = [
+            client.submit(call_job, fn, item, threads, key=f"labstand-{run_id}-{i}", pure=False)
+            for i, item in enumerate(items)
+        ]
     with remembered_interrupt() as interrupted:
+        if submitting.is_set():
+            interrupted.set()
         return _gather(client, futures, keys, progress, tell, interrupted)
 
 
@@ -131,6 +134,8 @@ def _gather(
     index = {f.key: i for i, f in enumerate(futures)}
     results: dict[int, JobResult[R]] = {}
     try:
+        if interrupted.is_set():  # during the submission
+            raise KeyboardInterrupt
         for future in as_completed(futures):
             if interrupted.is_set():
                 raise KeyboardInterrupt
