@@ -2,11 +2,11 @@
 
 For one campaign (a validation case's recordings with ``--case DIR``, else a drawn
 campaign of the check), the baseline is fitted once; then, for each candidate effect,
-its start grid (``fitting.effect_grid_start``'s points) is scored in full (every point
-on every trace: numpy's argmin of the summed costs) and by ``least_cost_point``,
-alternately for ``--rounds`` rounds. Prints per candidate the grid's size, the share of
-the plain grid's simulated samples the bounds needed, the best time of each, and
-whether both chose the same point.
+its start grid (``fitting.effect_grid_points``, without the extra points) is scored in
+full (every point on every trace: numpy's argmin of the summed costs) and by
+``least_cost_point``, alternately for ``--rounds`` rounds. Prints per candidate the
+grid's size, the share of the plain grid's simulated samples the bounds needed, the best
+time of each, and whether both chose the same point.
 
 Run: ``.venv/bin/python benchmarks/bench_grid_bounds.py [--case ../shared/validation/val_02]``.
 """
@@ -28,13 +28,7 @@ from recordings import open_recording
 from sim.config import default_config, load_config
 from sim.effects import EFFECTS
 from sim.identify.check import CaseSpec, make_campaign
-from sim.identify.fitting import (
-    EFFECT_GRID_LEVELS,
-    Candidate,
-    Objective,
-    fit,
-    grid_axis,
-)
+from sim.identify.fitting import Candidate, effect_grid_points, fit, trace_costs
 from sim.identify.least_cost import FloatArray, TraceCost, least_cost_point
 from sim.identify.shooting import dial_slope
 from sim.identify.traces import Trace
@@ -58,18 +52,6 @@ def load(case: Path | None) -> tuple[list[Trace], StandParams]:
     return [dataclasses.replace(tr, dial_slope=slope) for tr in traces], nominal
 
 
-def grid(cand: Candidate, baseline: dict[str, float]) -> FloatArray:
-    own = [p for p in cand.params if p.name not in baseline]
-    axes = [grid_axis(p, EFFECT_GRID_LEVELS.get(len(own), 2)) for p in own]
-    mesh = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, len(own))
-    fixed = [p.to_internal(baseline[p.name]) for p in cand.params if p.name in baseline]
-    return np.hstack([np.tile(fixed, (len(mesh), 1)), mesh])
-
-
-def cost(objective: Objective, zs: FloatArray) -> FloatArray:
-    return np.asarray(np.sum(objective.residuals_batch(zs) ** 2, axis=1), dtype=np.float64)
-
-
 def counted(costs: Sequence[TraceCost], sizes: Sequence[int], tally: list[int]) -> list[TraceCost]:
     def one(k: int, zs: FloatArray) -> FloatArray:
         tally.append(sizes[k] * len(zs))
@@ -89,10 +71,8 @@ def main() -> None:
     print(f"{'candidate':28s} {'points':>6s} {'samples':>8s} {'plain':>8s} {'bounds':>8s} same")
     for effect in EFFECTS:
         cand = Candidate.build(effect)
-        points = grid(cand, base.values)
-        parts = [Objective(cand, [tr], nominal) for tr in traces]
-        costs = [partial(cost, part) for part in parts]
-        sizes = [part.scored_span for part in parts]
+        points = effect_grid_points(cand, base.values)
+        costs, sizes = trace_costs(cand, traces, nominal)
         plain_s, bound_s = np.inf, np.inf
         tally: list[int] = []
         for _ in range(args.rounds):

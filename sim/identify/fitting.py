@@ -27,7 +27,7 @@ from numpy.typing import NDArray
 from scipy.optimize import least_squares
 
 from sim.effects import EFFECTS, EffectSpec, ParamInfo
-from sim.identify.least_cost import least_cost_point
+from sim.identify.least_cost import TraceCost, least_cost_point
 from sim.identify.side_by_side import side_by_side
 from sim.identify.traces import Trace
 from sim.model import Model, Variant
@@ -385,6 +385,16 @@ def effect_grid_start(
     τ levels 0.08 s apart by a factor 3.5, the refit stuck at 0.29 s). The least-cost
     point is found by bounds (``least_cost``): the same point, fewer simulations.
     """
+    points = effect_grid_points(candidate, baseline, extra)
+    costs, sizes = trace_costs(candidate, traces, nominal, stride)
+    recorded = range(len(points) - len(extra), len(points))
+    return candidate.natural(points[least_cost_point(costs, sizes, points, recorded)])
+
+
+def effect_grid_points(
+    candidate: Candidate, baseline: dict[str, float], extra: Sequence[dict[str, float]] = ()
+) -> FloatArray:
+    """``effect_grid_start``'s points (optimiser coordinates), the ``extra`` ones last."""
     own = [p for p in candidate.params if p.name not in baseline]
     levels = EFFECT_GRID_LEVELS.get(len(own), 2)
     axes = [grid_axis(p, levels) for p in own]
@@ -404,12 +414,19 @@ def effect_grid_start(
                 ]
             )
         )
-    # Each trace on its own (a fit's residuals are per trace): bounds prune the grid.
+    return np.stack(points)
+
+
+def trace_costs(
+    candidate: Candidate, traces: Sequence[Trace], nominal: StandParams, stride: int = 4
+) -> tuple[list[TraceCost], list[int]]:
+    """Each trace's training cost of many parameter vectors, and how far its runs go.
+
+    A fit's residuals are per trace, so these sum to its cost (``least_cost`` prunes by
+    them).
+    """
     parts = [Objective(candidate, [tr], nominal, stride) for tr in traces]
-    costs = [partial(_batch_cost, part) for part in parts]
-    sizes = [part.scored_span for part in parts]
-    recorded = range(len(points) - len(extra), len(points))
-    return candidate.natural(points[least_cost_point(costs, sizes, np.stack(points), recorded)])
+    return [partial(_batch_cost, part) for part in parts], [part.scored_span for part in parts]
 
 
 def _batch_cost(objective: Objective, zs: FloatArray) -> FloatArray:
