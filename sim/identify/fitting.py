@@ -434,6 +434,27 @@ def _batch_cost(objective: Objective, zs: FloatArray) -> FloatArray:
     return np.asarray(np.sum(objective.residuals_batch(zs) ** 2, axis=1), dtype=np.float64)
 
 
+def least_cost_values(
+    candidate: Candidate,
+    traces: Sequence[Trace],
+    nominal: StandParams,
+    points: Sequence[dict[str, float]],
+    stride: int = 4,
+) -> tuple[dict[str, float], float, int]:
+    """The least training cost among whole value sets, in one batch: (values, cost, sims).
+
+    Values outside a parameter's range are clipped into it, as a fit's start would be.
+    """
+    objective = Objective(candidate, traces, nominal, stride)
+    zs = np.array(
+        [[p.to_internal(float(np.clip(v[p.name], p.low, p.high))) for p in candidate.params]
+         for v in points]
+    )  # fmt: skip
+    costs = _batch_cost(objective, zs)
+    best = int(np.argmin(costs))
+    return candidate.natural(zs[best]), float(costs[best]), objective.simulations
+
+
 def fit(
     candidate: Candidate,
     traces: Sequence[Trace],
