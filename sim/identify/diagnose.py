@@ -78,11 +78,12 @@ POLISH_EVALUATIONS = 40
 #: two (up to four refits instead of six), once the pulley jump's refits read the seat
 #: again (``read_again``), the 32 pair campaigns of ``diagnose-check --truth other
 #: --pairs`` seeds 1 and 2 named both effects in 23, with three in 25: a better first
-#: effect leaves a smaller part of the gap, and the second moves down the score test's
-#: list (a light pulley behind a ratchet: third).
+#: effect leaves a smaller part of the gap, and the second moves down a list (a light
+#: pulley behind a ratchet: third by its training cost alone; a heavy one behind a gauge
+#: low-pass: third on the score test). Three and two named 24.
 SECOND_STAGE = 3
 #: A runner-up is "indistinguishable" from the chosen effect unless the chosen one beats
-#: it on held-out cycles at this one-sided p-value.
+#: it on held-out cycles at this one-sided p-value (and by a gain X resolves: ``beats``).
 DISTINCT_P = 0.05
 
 Progress = Callable[[str], None]
@@ -484,8 +485,8 @@ def _data_starts(
 #: Each effect's start points from the recordings or the fit (``_data_starts``).
 _DATA_STARTS = {SEAT_EFFECT: seat_probes, BRANCH_EFFECT: branch_starts}
 #: … and those read again with the refit's own baseline (``read_again``). Not the
-#: branch's: its starts give back a share of the baseline's k and c that the refit's
-#: already holds the branch's part of.
+#: branch's: its starts take the branch's share out of k and c, and a refit's k and c
+#: with a branch in its model hold no such share.
 _READ_AGAIN = {SEAT_EFFECT: seat_probes}
 
 
