@@ -141,6 +141,12 @@ class Candidate:
         """Optimiser vector → named natural values."""
         return {p.name: p.to_natural(float(v)) for p, v in zip(self.params, z, strict=True)}
 
+    def internal(self, values: dict[str, float]) -> FloatArray:
+        """Named natural values → optimiser vector, each clipped into its fitting range."""
+        return np.array(
+            [p.to_internal(float(np.clip(values[p.name], p.low, p.high))) for p in self.params]
+        )
+
     def model(self, nominal: StandParams, mass_kg: float) -> Model:
         """The candidate's model: the nominal stand at this mass, with its effects."""
         return Model(nominal.with_(mass_kg=mass_kg), [EffectSpec(e) for e in self.effects])
@@ -404,16 +410,7 @@ def effect_grid_points(
         z = dict(base)
         z.update({p.name: float(v) for p, v in zip(own, combo, strict=True)})
         points.append(np.array([z[p.name] for p in candidate.params]))
-    for values in extra:
-        merged = {**baseline, **values}
-        points.append(
-            np.array(
-                [
-                    p.to_internal(float(np.clip(merged[p.name], p.low, p.high)))
-                    for p in candidate.params
-                ]
-            )
-        )
+    points += [candidate.internal({**baseline, **values}) for values in extra]
     return np.stack(points)
 
 
@@ -446,10 +443,7 @@ def least_cost_values(
     Values outside a parameter's range are clipped into it, as a fit's start would be.
     """
     objective = Objective(candidate, traces, nominal, stride)
-    zs = np.array(
-        [[p.to_internal(float(np.clip(v[p.name], p.low, p.high))) for p in candidate.params]
-         for v in points]
-    )  # fmt: skip
+    zs = np.stack([candidate.internal(v) for v in points])
     costs = _batch_cost(objective, zs)
     best = int(np.argmin(costs))
     return candidate.natural(zs[best]), float(costs[best]), objective.simulations
@@ -479,16 +473,8 @@ def fit(
     if not candidate.effects and baseline is None:
         starts = _grid_starts(objective)
     if single_start and baseline is not None:
-        starts = [
-            np.array(
-                [
-                    p.to_internal(
-                        float(np.clip(baseline.get(p.name, 0.5 * (p.low + p.high)), p.low, p.high))
-                    )
-                    for p in candidate.params
-                ]
-            )
-        ]
+        middle = {p.name: 0.5 * (p.low + p.high) for p in candidate.params}
+        starts = [candidate.internal({**middle, **baseline})]
     # Thresholds (``FreeParam.scan``) stay where the start put them: a gradient cannot
     # move a parameter whose output error changes in steps.
     free = np.array([not p.scan for p in candidate.params])
