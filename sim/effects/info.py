@@ -102,6 +102,10 @@ class ParamInfo:
     scan: tuple[float, ...] = ()
     #: A count (a scanned threshold taking whole values only): scanned at ``scan`` alone.
     integer: bool = False
+    #: Says how the effect acts rather than how large it is (a friction model's presliding
+    #: stiffness): held at ``default`` in every candidate's refit, fitted only for the
+    #: candidate that fits the training cycles best (``sim.identify.diagnose.refine_form``).
+    form: bool = False
 
     @property
     def fit_low(self) -> float:
@@ -129,6 +133,7 @@ class ParamInfo:
             "minimum": self.minimum,
             "maximum": self.maximum,
             "fit": self.fit,
+            "form": self.form,
             "log": self.log,
             "bounds": [self.fit_low, self.fit_high],
             "why": self.why,
@@ -202,8 +207,8 @@ def param(name: str, unit: str, default: float, plausible: tuple[float, float],
           admissible: tuple[float, float], column: int, description: str, *,
           fit: bool = True, log: bool = False, drawn: bool | None = None,
           bounds: tuple[float, float] = (0.0, 0.0), why: str = "",
-          scan: tuple[float, ...] = (), integer: bool = False) -> ParamInfo:
+          scan: tuple[float, ...] = (), integer: bool = False, form: bool = False) -> ParamInfo:
     """A ParamInfo from the typical (``plausible``) and admissible ranges as pairs."""
     return ParamInfo(name, unit, default, *plausible, *admissible, description, column, fit, log,
-                     drawn, bounds, why, scan, integer)
+                     drawn, bounds, why, scan, integer, form)
 # fmt: on

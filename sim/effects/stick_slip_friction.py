@@ -31,7 +31,12 @@ INFO = EffectInfo(
               why="measured Stribeck curves fall exponentially (δ ≈ 0.5–1) to like a "
                   "Gaussian (δ = 2) or steeper, with the lubricant and the surfaces"),
         param("bristle_stiffness_n_m", "N/m", 1.0e5, (3.0e4, 3.0e5), (1.0e3, 1.0e7),
-              ek.R_SS_SIGMA, "σ₀, presliding stiffness (σ₁ = 2√(σ₀m))", fit=False, log=True),
+              ek.R_SS_SIGMA, "σ₀, presliding stiffness (σ₁ = 2√(σ₀m))", log=True,
+              drawn=False, form=True, bounds=(3.0e4, 1.0e6),
+              why="the contact's stiffness before it slides: the weight's 1.7–4.5 N of "
+                  "kinetic friction over a presliding displacement of 2–150 µm (steel on "
+                  "greased steel: micrometres to a tenth of a millimetre); a stick band "
+                  "that holds the weight still (Karnopp) is its stiff limit"),
     ),
     carried=True,
 )

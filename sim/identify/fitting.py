@@ -19,7 +19,7 @@ from __future__ import annotations
 import logging
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import partial
 
 import numpy as np
@@ -66,6 +66,9 @@ class FreeParam:
     scan: tuple[float, ...] = ()
     #: A count: scanned at its levels only, not between them.
     integer: bool = False
+    #: A form parameter (``ParamInfo.form``) held at this value: not moved by a local fit,
+    #: one level in a start grid, the value where a start does not give one. None: fitted.
+    held: float | None = None
 
     def to_internal(self, value: float) -> float:
         """Natural value → optimiser coordinate."""
@@ -74,6 +77,21 @@ class FreeParam:
         if self.scale == "asinh":
             return float(np.arcsinh(value / self.width))
         return value
+
+    def given(self, values: dict[str, float]) -> float | None:
+        """Its value in ``values``, else where it is held; None if neither."""
+        return values.get(self.name, self.held)
+
+    def value_in(self, values: dict[str, float]) -> float:
+        """Its value in ``values``, else where it is held (KeyError if neither)."""
+        value = self.given(values)
+        if value is None:
+            raise KeyError(self.name)
+        return value
+
+    def clipped(self, value: float) -> float:
+        """Natural value → optimiser coordinate, clipped into the fitting range first."""
+        return self.to_internal(float(np.clip(value, self.low, self.high)))
 
     def bounds(self) -> tuple[float, float]:
         """Optimiser bounds."""
@@ -104,12 +122,13 @@ class FreeParam:
 def _free(effect: str, p: ParamInfo) -> FreeParam:
     """An effect parameter as fitted: within its physical range (``ParamInfo.bounds``)."""
     low, high, typical, name = p.fit_low, p.fit_high, (p.low, p.high), f"{effect}.{p.name}"
+    held = p.default if p.form else None
     if p.log and low > 0:
-        return FreeParam(name, low, high, "log", typical=typical, scan=p.scan, integer=p.integer)
+        return FreeParam(name, low, high, "log", 1.0, typical, p.scan, p.integer, held)
     if p.log:  # signed, spanning decades
         width = max(abs(p.low), abs(p.high)) / 4
-        return FreeParam(name, low, high, "asinh", width, typical, p.scan, p.integer)
-    return FreeParam(name, low, high, typical=typical, scan=p.scan, integer=p.integer)
+        return FreeParam(name, low, high, "asinh", width, typical, p.scan, p.integer, held)
+    return FreeParam(name, low, high, "lin", 1.0, typical, p.scan, p.integer, held)
 
 
 @dataclass
@@ -142,10 +161,15 @@ class Candidate:
         return {p.name: p.to_natural(float(v)) for p, v in zip(self.params, z, strict=True)}
 
     def internal(self, values: dict[str, float]) -> FloatArray:
-        """Named natural values → optimiser vector, each clipped into its fitting range."""
-        return np.array(
-            [p.to_internal(float(np.clip(values[p.name], p.low, p.high))) for p in self.params]
-        )
+        """Named natural values → optimiser vector, each clipped into its fitting range.
+
+        A held form parameter that ``values`` lacks takes its held value.
+        """
+        return np.array([p.clipped(p.value_in(values)) for p in self.params])
+
+    def freed(self) -> Candidate:
+        """The same candidate with its held form parameters fitted too."""
+        return Candidate(self.effects, [replace(p, held=None) for p in self.params])
 
     def model(self, nominal: StandParams, mass_kg: float) -> Model:
         """The candidate's model: the nominal stand at this mass, with its effects."""
@@ -170,8 +194,9 @@ class Candidate:
         for frac in fractions:
             z = []
             for p in self.params:
-                if p.name in base:
-                    z.append(p.to_internal(float(np.clip(base[p.name], p.low, p.high))))
+                given = p.given(base)
+                if given is not None:
+                    z.append(p.clipped(given))
                 else:
                     lo, hi = p.bounds()
                     z.append(lo + frac * (hi - lo))
@@ -357,6 +382,8 @@ def grid_axis(p: FreeParam, levels: int) -> FloatArray:
     lo, hi = p.bounds()
     if p.integer:  # a count: its first level; the scan after the local fit finds the rest
         return np.array([p.to_internal(p.scan[0])])
+    if p.held is not None:  # a form parameter: where it is held
+        return np.array([p.to_internal(p.held)])
     if p.typical is None:
         return np.linspace(lo, hi, levels + 2)[1:-1]
     t_lo = float(np.clip(p.to_internal(max(p.typical[0], p.low)), lo, hi))
@@ -473,11 +500,11 @@ def fit(
     if not candidate.effects and baseline is None:
         starts = _grid_starts(objective)
     if single_start and baseline is not None:
-        middle = {p.name: 0.5 * (p.low + p.high) for p in candidate.params}
+        middle = {p.name: 0.5 * (p.low + p.high) for p in candidate.params if p.held is None}
         starts = [candidate.internal({**middle, **baseline})]
     # Thresholds (``FreeParam.scan``) stay where the start put them: a gradient cannot
-    # move a parameter whose output error changes in steps.
-    free = np.array([not p.scan for p in candidate.params])
+    # move a parameter whose output error changes in steps. Held form parameters stay too.
+    free = np.array([not p.scan and p.held is None for p in candidate.params])
     for start in starts:
         z0 = np.clip(start, lo + 1e-9 * (hi - lo), hi - 1e-9 * (hi - lo))
 

@@ -53,7 +53,7 @@ def probe_values(effect: str, baseline: dict[str, float]) -> list[dict[str, floa
     for frac in (0.2, 0.5, 1.0):
         values = dict(baseline)
         for p in info.params:
-            if not p.fit:
+            if not p.fit or p.form:  # a form parameter stays at its default
                 continue
             if p.low < 0 < p.high:  # signed: probe both ends
                 v = p.high * frac
@@ -63,7 +63,7 @@ def probe_values(effect: str, baseline: dict[str, float]) -> list[dict[str, floa
                 v = p.low + frac * (p.high - p.low)
             values[f"{effect}.{p.name}"] = v
         probes.append(values)
-        signed = [p for p in info.params if p.fit and p.low < 0 < p.high]
+        signed = [p for p in info.params if p.fit and not p.form and p.low < 0 < p.high]
         if signed:
             neg = dict(values)
             for p in signed:
