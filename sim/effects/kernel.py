@@ -78,6 +78,7 @@ ZERO = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
 NSUB_MAX = 64  # substeps per sample interval at most
 EXP_COST = 1.3  # an exponential step (_etdrk4) costs about this many RK4 steps (measured)
 MAX_SWITCH = 8  # regime switches per segment located inside one step (the baseline's 8)
+BRISTLE_SWING = 0.1  # relative change of the bristle's relaxation rate within one ETD step
 
 
 @njit(cache=True, error_model="numpy")
@@ -660,7 +661,17 @@ def _substeps(c, y, x, xd, dt, base):  # type: ignore[no-untyped-def]
         real = max(real, relax + c[D_SIG1] / c[P_MASS])
         # Exact for a frozen rate, but the rate swings through the Stribeck dip at every
         # reversal: still a bound, four times looser (σ₀ 1e6 N/m: 0.04 N off without).
-        real_exp = max(real_exp, c[D_SIG1] / c[P_MASS], relax / 4.0)
+        # Away from reversals the frozen rate errs by the rate's relative change within a
+        # step, |a|/|v|·(1 + r·δ/e) at most (|v|/g(v) through the Stribeck dip), |a| at
+        # most what the tensions, gravity and friction can give: a tenth per step.
+        pull = c[P_PROJ] * t_est + c[P_GRAVITY_N] + g_min * (1.0 + c[R_SS_RATIO])
+        a_max = pull / c[P_MASS]
+        slowest = abs(y[Y_V]) - a_max * dt
+        swing = relax / 4.0
+        if slowest > 0.0:
+            dip = 1.0 + c[R_SS_RATIO] * c[R_SS_EXP] / math.e
+            swing = min(swing, 1.5 * a_max / slowest * dip / BRISTLE_SWING)
+        real_exp = max(real_exp, c[D_SIG1] / c[P_MASS], swing)
     n = max(base, math.ceil(dt * osc / 0.5), math.ceil(dt * real / 1.5))
     n_exp = max(base, math.ceil(dt * osc_exp / 0.5), math.ceil(dt * real_exp / 1.5))
     if EXP_COST * n_exp < n:
