@@ -98,6 +98,16 @@ class _Fitted:
     excess: float
 
 
+def _short_fit(
+    candidate: Candidate, traces: Sequence[Trace], nominal: StandParams, start: dict[str, float]
+) -> FitResult:
+    """One short local fit from ``start`` (``REFIT_EVALUATIONS``, ``REFIT_FTOL``)."""
+    return fit(
+        candidate, traces, nominal, baseline=start, single_start=True,
+        max_nfev=REFIT_EVALUATIONS, ftol=REFIT_FTOL,
+    )  # fmt: skip
+
+
 def _refit(
     candidate: Candidate,
     traces: Sequence[Trace],
@@ -111,18 +121,12 @@ def _refit(
     refit, and is refitted once more from the scan's point if that lowered the cost.
     """
     start = effect_grid_start(candidate, traces, nominal, start_from, extra)
-    res = fit(
-        candidate, traces, nominal, baseline=start, single_start=True,
-        max_nfev=REFIT_EVALUATIONS, ftol=REFIT_FTOL,
-    )  # fmt: skip
+    res = _short_fit(candidate, traces, nominal, start)
     res = read_again(candidate, traces, nominal, res)
     if any(p.scan for p in candidate.params):
         scanned, cost, sims = scan_thresholds(candidate, traces, nominal, res.values)
         if cost < res.train_cost:
-            again = fit(
-                candidate, traces, nominal, baseline=scanned, single_start=True,
-                max_nfev=REFIT_EVALUATIONS, ftol=REFIT_FTOL,
-            )  # fmt: skip
+            again = _short_fit(candidate, traces, nominal, scanned)
             better = again if again.train_cost < cost else FitResult(candidate, scanned, cost, 0)
             res = dataclasses.replace(
                 better, evaluations=res.evaluations + sims + again.evaluations
@@ -155,10 +159,7 @@ def read_again(
     )
     evaluations = res.evaluations + sims
     if cost < res.train_cost:
-        again = fit(
-            candidate, traces, nominal, baseline=values, single_start=True,
-            max_nfev=REFIT_EVALUATIONS, ftol=REFIT_FTOL,
-        )  # fmt: skip
+        again = _short_fit(candidate, traces, nominal, values)
         evaluations += again.evaluations
         if again.train_cost < res.train_cost:
             res = again
@@ -183,10 +184,7 @@ def refine_form(
     if all(p.held is None for p in candidate.params):
         return fitted, 0
     say(f"fitting the form of {candidate.name}")
-    res = fit(
-        candidate.freed(), traces, nominal, baseline=fitted.result.values, single_start=True,
-        max_nfev=REFIT_EVALUATIONS, ftol=REFIT_FTOL,
-    )  # fmt: skip
+    res = _short_fit(candidate.freed(), traces, nominal, fitted.result.values)
     if res.train_cost >= fitted.result.train_cost:
         return fitted, res.evaluations
     outs = outputs_of(res.candidate, res.values, traces, nominal)
