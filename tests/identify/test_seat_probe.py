@@ -78,7 +78,7 @@ def test_seat_steps_are_read_again_with_the_refits_own_baseline(stand: StandConf
     # that basin (step −2.3 mm) with k and c near the truth. Read again there, the
     # steps give the ratchet: a far better fit, the truth's step and seats.
     from sim.identify.check import CaseSpec, make_campaign
-    from sim.identify.diagnose import REFIT_EVALUATIONS, REFIT_FTOL, read_again
+    from sim.identify.diagnose import _short_fit, read_again
     from sim.identify.fitting import Candidate, effect_grid_start, fit
     from sim.identify.shooting import dial_slope
     from sim.otherstand.campaign import OTHER_SETS
@@ -96,10 +96,7 @@ def test_seat_steps_are_read_again_with_the_refits_own_baseline(stand: StandConf
     start = effect_grid_start(
         candidate, traces, nominal, base.values, seat_probes(traces, nominal, base.values)
     )
-    first = fit(
-        candidate, traces, nominal, baseline=start, single_start=True,
-        max_nfev=REFIT_EVALUATIONS, ftol=REFIT_FTOL,
-    )  # fmt: skip
+    first = _short_fit(candidate, traces, nominal, start)
     again = read_again(candidate, traces, nominal, first)
     assert again.train_cost < 0.5 * first.train_cost
     step = truth[f"{EFFECT}.step_m"]
