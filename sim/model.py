@@ -242,7 +242,7 @@ class Model:
         """
         x_rel = check_input(x_m, rate_hz)
         base, rows = self._rows(variants, augmented=True)  # the start states need them
-        init = _starts.start_states(
+        init, seats = _starts.start_states_and_seats(
             rows, x_rel, rate_hz, restarts.starts, restarts.u_m, restarts.v_m_s,
             restarts.force_n, restarts.dial_slope,
         )  # fmt: skip
@@ -251,7 +251,7 @@ class Model:
         if self.physical:
             return _augmented.simulate_augmented_segments(
                 x_rel, rate_hz, rows, table, starts, lengths, init, self.substeps,
-                chained=self.chained, serial=serial,
+                chained=self.chained, serial=serial, seats=seats,
             )  # fmt: skip
         u, f = _baseline.simulate_segment_rows(
             x_rel, rate_hz, base, table, starts, lengths, init[:, :, :2], self.substeps, serial

@@ -208,6 +208,7 @@ def simulate_augmented_segments(
     substeps: int = DEFAULT_SUBSTEPS,
     chained: bool = False,
     serial: bool = False,
+    seats: FloatArray | None = None,
 ) -> tuple[FloatArray, FloatArray]:
     """Multiple shooting: many short runs of many rows from measured states, in parallel.
 
@@ -218,7 +219,9 @@ def simulate_augmented_segments(
     run when ``chained``. Returns the *recorded* u (m) and F (N), shape (sets, segments,
     max length), each segment measured on its own (``measure_segments``), last value
     held past its end. ``serial``: on the calling thread, without the GIL (several
-    traces side by side) instead of on all cores.
+    traces side by side) instead of on all cores. ``seats`` (sets, samples): the pulley
+    seat's offset each row's runs hold at every sample, as the recorded slack episodes
+    put it (``_starts.start_states_and_seats``); None: the model's own slack moves it.
     """
     rows2 = np.ascontiguousarray(np.atleast_2d(rows), dtype=np.float64)
     sets, segs, width = rows2.shape[0], starts.shape[0], int(lengths.max())
@@ -236,6 +239,7 @@ def simulate_augmented_segments(
         knots, coef, np.ascontiguousarray(starts, dtype=np.int64),
         np.ascontiguousarray(lengths, dtype=np.int64),
         np.ascontiguousarray(init, dtype=np.float64), u, t1,
+        np.zeros((sets, 0)) if seats is None else np.ascontiguousarray(seats, dtype=np.float64),
     )  # fmt: skip
     return measure_segments(u, t1, rate_hz, rows2, starts, init)
 

@@ -17,13 +17,14 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sim.effects import kernel as ek
+from sim.effects.fibre_pulley_jump import recorded_seat
 from sim.effects.info import EffectInfo, Measured
 from sim.effects.registry import EFFECTS
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
 
-__all__ = ["start_states"]
+__all__ = ["start_states", "start_states_and_seats"]
 
 
 def start_states(
@@ -41,8 +42,31 @@ def start_states(
     ``u_m``, ``v_m_s``, ``force_n``: the recorded channels (smoothed) at every sample;
     ``dial_slope``: du_rec/dx at constant force (NaN: take the gauge's scale as 1).
     """
+    return start_states_and_seats(rows, x_rel_m, rate_hz, starts, u_m, v_m_s, force_n, dial_slope)[
+        0
+    ]
+
+
+def start_states_and_seats(
+    rows: FloatArray,
+    x_rel_m: FloatArray,
+    rate_hz: float,
+    starts: IntArray,
+    u_m: FloatArray,
+    v_m_s: FloatArray,
+    force_n: FloatArray,
+    dial_slope: float = float("nan"),
+) -> tuple[FloatArray, FloatArray]:
+    """``start_states``, and the pulley seat the recorded slack puts each row in.
+
+    The seats: (sets, samples), each row's seat offset at every sample
+    (``fibre_pulley_jump.recorded_seat``; 0 where the row has no pulley jump), or
+    (sets, 0) if no row has one (every run's seat is then the model's).
+    """
     rows2 = np.atleast_2d(rows)
     init = np.zeros((rows2.shape[0], starts.size, ek.N_INIT))
+    jumps = rows2[:, ek.R_PJ_ON] > 0
+    seats = np.zeros((rows2.shape[0], x_rel_m.size if np.any(jumps) else 0))
     # Rows whose channel transforms agree share their true channels (every row of a fit
     # but a skew's): computed once per batch, not once per row over the whole trace.
     channels: dict[bytes, tuple[FloatArray, FloatArray, FloatArray, FloatArray]] = {}
@@ -61,7 +85,9 @@ def start_states(
         for info in on:
             if info.start_state is not None:
                 info.start_state(row, measured, starts, init[b])
-    return init
+        if jumps[b]:
+            seats[b] = recorded_seat(row, measured)
+    return init, seats
 
 
 def _transform_key(row: FloatArray, on: list[EffectInfo]) -> bytes:

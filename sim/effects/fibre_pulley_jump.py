@@ -14,17 +14,36 @@ from sim.effects.info import EffectInfo, Measured, param
 FloatArray = NDArray[np.float64]
 
 
+def _slack_n(row: FloatArray) -> float:
+    # Slack: the force below 5 % of the rest tension, well above the gauge's noise and hum
+    # (tenths of a newton) and far below a taut fibre's force.
+    return float(0.05 * row[ek.P_GRAVITY_N] / row[ek.P_PROJ])
+
+
 def _start_state(
     row: FloatArray, measured: Measured, starts: NDArray[np.int64], init: FloatArray
 ) -> None:
-    # The seat follows the recorded slack episodes (``kernel.measured_seats``). Slack: the
-    # force below 5 % of the rest tension, well above the gauge's noise and hum (tenths
-    # of a newton) and far below a taut fibre's force.
-    slack_n = 0.05 * row[ek.P_GRAVITY_N] / row[ek.P_PROJ]
+    # The seat follows the recorded slack episodes (``kernel.measured_seats``).
     init[:, ek.I_LOFF : ek.I_SLACKT + 1] = ek.measured_seats(
         row, measured.x_rel_m, measured.u_m, measured.force_n, 1.0 / measured.rate_hz,
-        slack_n, starts,
+        _slack_n(row), starts,
     )  # fmt: skip
+
+
+def recorded_seat(row: FloatArray, measured: Measured) -> FloatArray:
+    """The seat's offset at every sample, as the recorded slack episodes put it (m).
+
+    What a segment's run holds the seat at (``kernel._advance``), rather than letting it
+    follow the model's own slack: on the light weight's chaotic bounces the simulated
+    episodes' lengths straddle a dwell threshold that the recorded ones clear or miss
+    cleanly, and the toggle goes wrong inside segments (docs/diagnosis.md, val_12).
+    """
+    every = np.arange(measured.x_rel_m.size, dtype=np.int64)
+    seats = ek.measured_seats(
+        row, measured.x_rel_m, measured.u_m, measured.force_n, 1.0 / measured.rate_hz,
+        _slack_n(row), every,
+    )  # fmt: skip
+    return np.ascontiguousarray(seats[:, 0], dtype=np.float64)
 
 
 # The same declarative shape in every effect module (what it means: sim/effects/info.py).

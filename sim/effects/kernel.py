@@ -70,7 +70,10 @@ N_ROW = R_X + N_X
 # decay rate at rest; the oscillation bound that remains with them exact; the rim's weights
 # (``_rim_weights``: rate, step, then the six weights).
 E_ON, E_RIM, E_OSC, E_RATE, E_H, E_W = range(N_ROW + 44, N_ROW + 50)
-C_TABLE = N_ROW + 55  # c[C_TABLE] = knots n, then the n knots, then coef (4, n − 1) by rows
+# The pulley seat follows the recorded slack episodes (``_advance``'s ``seat``), not the
+# model's: 1.0 while a run is given them.
+S_RECSEAT = N_ROW + 55
+C_TABLE = N_ROW + 56  # c[C_TABLE] = knots n, then the n knots, then coef (4, n − 1) by rows
 
 (Y_U, Y_V, Y_S, Y_SD, Y_Q1, Y_Q2, Y_A1, Y_AD1, Y_A2, Y_AD2, Y_Z) = range(11)
 NY = 11
@@ -535,7 +538,7 @@ def _after_part(c, y, x, xd, h):  # type: ignore[no-untyped-def]
         zmax = _bearing_limit(c, t1, t2)
         c[S_PZ] = min(max(c[S_PZ] + y[Y_S] - c[S_PS0], -zmax), zmax)
         c[S_PS0] = y[Y_S]
-    if c[R_PJ_ON] > 0.0:
+    if c[R_PJ_ON] > 0.0 and c[S_RECSEAT] == 0.0:
         # The weight-side segment carries the seat (one segment: S_TAUT2 is only
         # refreshed at a step's start; S_TAUT1 follows every located switch).
         taut = c[S_TAUT2] if c[D_NSEG] > 1.5 else c[S_TAUT1]
@@ -701,14 +704,30 @@ def advance_into(x, dt, substeps, c, state, out_u, out_v, out_t1, out_t2):  # ty
     out_*[i + 1] and the final state back into ``state`` and c, so a run can go on block
     by block. Returns the largest number of substeps one interval took.
     """
+    return _advance(x, dt, substeps, c, state, out_u, out_v, out_t1, out_t2, np.empty(0))
+
+
+@njit(cache=True, error_model="numpy")
+def _advance(x, dt, substeps, c, state, out_u, out_v, out_t1, out_t2, seat):  # type: ignore[no-untyped-def]
+    """``advance_into``; with ``seat`` (one per sample of x) the pulley seat's offset.
+
+    A seat given is the one the *recorded* slack episodes put the fibre in
+    (``measured_seats`` at every sample): over the interval after sample i the seat is
+    seat[i + 1], the episodes up to sample i read. Without, the seat follows the model's
+    own slack (``_after_part``).
+    """
     y = (
         state[0], state[1], state[2], state[3], state[4], state[5], state[6], state[7],
         state[8], state[9], state[10],
     )  # fmt: skip
     c[S_ZONE] = _zone(y[Y_V], c)
+    recorded = seat.shape[0] >= x.shape[0] and c[R_PJ_ON] > 0.0
+    c[S_RECSEAT] = 1.0 if recorded else 0.0
     most = 0
     for i in range(x.shape[0] - 1):
         xd = (x[i + 1] - x[i]) / dt
+        if recorded:
+            c[S_LOFF] = seat[i + 1]
         nsub = _substeps(c, y, x[i], xd, dt, substeps)
         most = max(most, nsub)
         h = dt / nsub
@@ -717,12 +736,19 @@ def advance_into(x, dt, substeps, c, state, out_u, out_v, out_t1, out_t2):  # ty
         _sample_out(c, y, x[i + 1], xd, i + 1, out_u, out_v, out_t1, out_t2)
     for k in range(NY):
         state[k] = y[k]
+    c[S_RECSEAT] = 0.0
     return most
 
 
 @njit(cache=True, error_model="numpy")
 def simulate_into(x, dt, substeps, row, knots, coef, out_u, out_v, out_t1, out_t2):  # type: ignore[no-untyped-def]
     """Integrate one parameter row from static rest over the drive samples x (relative)."""
+    return _from_rest(x, dt, substeps, row, knots, coef, out_u, out_v, out_t1, out_t2, np.empty(0))
+
+
+@njit(cache=True, error_model="numpy")
+def _from_rest(x, dt, substeps, row, knots, coef, out_u, out_v, out_t1, out_t2, seat):  # type: ignore[no-untyped-def]
+    """``simulate_into``, the seat given as in ``_advance``."""
     c = pack(row, knots, coef)
     y = rest_state(c)
     out_u[0] = y[Y_U]
@@ -732,7 +758,7 @@ def simulate_into(x, dt, substeps, row, knots, coef, out_u, out_v, out_t1, out_t
     state = np.empty(NY)
     for k in range(NY):
         state[k] = y[k]
-    return advance_into(x, dt, substeps, c, state, out_u, out_v, out_t1, out_t2)
+    return _advance(x, dt, substeps, c, state, out_u, out_v, out_t1, out_t2, seat)
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
@@ -830,7 +856,9 @@ def measured_state(c, x, xd, m):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
-def simulate_chained_into(x, dt, substeps, rows, knots, coef, starts, lens, init, out_u, out_t1):  # type: ignore[no-untyped-def]
+def simulate_chained_into(  # type: ignore[no-untyped-def]
+    x, dt, substeps, rows, knots, coef, starts, lens, init, out_u, out_t1, seats
+):
     """``simulate_segments_into`` segment after segment per row (parallel over rows only).
 
     The string modes and the LuGre bristle are not observable from the gauges at a start
@@ -841,18 +869,22 @@ def simulate_chained_into(x, dt, substeps, rows, knots, coef, starts, lens, init
     seat from the recorded slack episodes, ``measured_seats``).
     """
     for b in prange(rows.shape[0]):
-        _chain_into(b, x, dt, substeps, rows, knots, coef, starts, lens, init, out_u, out_t1)
+        _chain_into(b, x, dt, substeps, rows, knots, coef, starts, lens, init, out_u, out_t1, seats)
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
-def simulate_chained_serial(x, dt, substeps, rows, knots, coef, starts, lens, init, out_u, out_t1):  # type: ignore[no-untyped-def]
+def simulate_chained_serial(  # type: ignore[no-untyped-def]
+    x, dt, substeps, rows, knots, coef, starts, lens, init, out_u, out_t1, seats
+):
     """``simulate_chained_into`` on the calling thread, without the GIL (traces side by side)."""
     for b in range(rows.shape[0]):
-        _chain_into(b, x, dt, substeps, rows, knots, coef, starts, lens, init, out_u, out_t1)
+        _chain_into(b, x, dt, substeps, rows, knots, coef, starts, lens, init, out_u, out_t1, seats)
 
 
 @njit(cache=True, error_model="numpy")
-def _chain_into(b, x, dt, substeps, rows, knots, coef, starts, lens, init, out_u, out_t1):  # type: ignore[no-untyped-def]
+def _chain_into(  # type: ignore[no-untyped-def]
+    b, x, dt, substeps, rows, knots, coef, starts, lens, init, out_u, out_t1, seats
+):
     """Row b of ``simulate_chained_into``: its segments one after the other."""
     segs = starts.shape[0]
     carried = np.zeros(NY - Y_A1)
@@ -861,6 +893,7 @@ def _chain_into(b, x, dt, substeps, rows, knots, coef, starts, lens, init, out_u
         n = lens[s]
         xs = x[starts[s] : starts[s] + n]
         ou, ot = out_u[b, s], out_t1[b, s]
+        seat = seats[b, starts[s] : starts[s] + n]  # empty: the model's own slack
         sv, st2 = np.empty(n), np.empty(n)
         c = pack(rows[b], knots, coef)
         xd = (xs[1] - xs[0]) / dt if n > 1 else 0.0
@@ -884,57 +917,70 @@ def _chain_into(b, x, dt, substeps, rows, knots, coef, starts, lens, init, out_u
         hand = starts[s + 1] - starts[s] if s + 1 < segs else n
         if 0 < hand < n:
             h1 = hand + 1
-            advance_into(xs[:h1], dt, substeps, c, state, ou[:h1], sv[:h1], ot[:h1], st2[:h1])
+            _advance(
+                xs[:h1], dt, substeps, c, state, ou[:h1], sv[:h1], ot[:h1], st2[:h1], seat[:h1]
+            )
             for k in range(NY - Y_A1):
                 carried[k] = state[Y_A1 + k]
             have = True
             tail = slice(hand, n)
-            advance_into(xs[tail], dt, substeps, c, state, ou[tail], sv[tail], ot[tail], st2[tail])
+            _advance(
+                xs[tail], dt, substeps, c, state, ou[tail], sv[tail], ot[tail], st2[tail],
+                seat[tail],
+            )  # fmt: skip
         elif n > 1:
-            advance_into(xs, dt, substeps, c, state, ou, sv, ot, st2)
+            _advance(xs, dt, substeps, c, state, ou, sv, ot, st2, seat)
         for i in range(n, ou.shape[0]):
             ou[i] = ou[n - 1]
             ot[i] = ot[n - 1]
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
-def simulate_segments_into(x, dt, substeps, rows, knots, coef, starts, lens, init, out_u, out_t1):  # type: ignore[no-untyped-def]
+def simulate_segments_into(  # type: ignore[no-untyped-def]
+    x, dt, substeps, rows, knots, coef, starts, lens, init, out_u, out_t1, seats
+):
     """Many short runs (segments) of many rows, in parallel over (set, segment).
 
     Segment s covers samples starts[s] … starts[s] + lens[s] − 1 of the relative drive
     x. A segment at sample 0 starts from static rest (as ``simulate_into``); any other
     from ``measured_state`` of init[b, s] (columns I_*). Writes u and the drive-side
     tension into out_*[b, s, :lens[s]], the last value held to the end of the row.
+    seats[b] (one per sample of x, or none): the pulley seat the runs hold (``_advance``).
     """
     segs = starts.shape[0]
     for flat in prange(rows.shape[0] * segs):
         _segment_into(
             flat // segs, flat % segs, x, dt, substeps, rows, knots, coef, starts, lens, init,
-            out_u, out_t1,
+            out_u, out_t1, seats,
         )  # fmt: skip
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
-def simulate_segments_serial(x, dt, substeps, rows, knots, coef, starts, lens, init, out_u, out_t1):  # type: ignore[no-untyped-def]
+def simulate_segments_serial(  # type: ignore[no-untyped-def]
+    x, dt, substeps, rows, knots, coef, starts, lens, init, out_u, out_t1, seats
+):
     """``simulate_segments_into`` on the calling thread, without the GIL (traces side by side)."""
     segs = starts.shape[0]
     for flat in range(rows.shape[0] * segs):
         _segment_into(
             flat // segs, flat % segs, x, dt, substeps, rows, knots, coef, starts, lens, init,
-            out_u, out_t1,
+            out_u, out_t1, seats,
         )  # fmt: skip
 
 
 @njit(cache=True, error_model="numpy")
-def _segment_into(b, s, x, dt, substeps, rows, knots, coef, starts, lens, init, out_u, out_t1):  # type: ignore[no-untyped-def]
+def _segment_into(  # type: ignore[no-untyped-def]
+    b, s, x, dt, substeps, rows, knots, coef, starts, lens, init, out_u, out_t1, seats
+):
     """Segment s of row b of ``simulate_segments_into``."""
     n = lens[s]
     xs = x[starts[s] : starts[s] + n]
     ou = out_u[b, s]
     ot = out_t1[b, s]
+    seat = seats[b, starts[s] : starts[s] + n]  # empty: the model's own slack
     sv, st2 = np.empty(n), np.empty(n)
     if starts[s] == 0:
-        simulate_into(xs, dt, substeps, rows[b], knots, coef, ou, sv, ot, st2)
+        _from_rest(xs, dt, substeps, rows[b], knots, coef, ou, sv, ot, st2, seat)
     else:
         c = pack(rows[b], knots, coef)
         xd = (xs[1] - xs[0]) / dt if n > 1 else 0.0
@@ -945,7 +991,7 @@ def _segment_into(b, s, x, dt, substeps, rows, knots, coef, starts, lens, init, 
         for k in range(NY):
             state[k] = y[k]
         if n > 1:
-            advance_into(xs, dt, substeps, c, state, ou, sv, ot, st2)
+            _advance(xs, dt, substeps, c, state, ou, sv, ot, st2, seat)
     for i in range(n, ou.shape[0]):
         ou[i] = ou[n - 1]
         ot[i] = ot[n - 1]

@@ -27,8 +27,9 @@ at most one segment and the fit compares the model's short-term dynamics with th
   skew), so the state is the true one the candidate implies. The model does that
   (``sim.model.Model.run_segments``), and sets the effects' own states: quasi-static
   values, and for the Maxwell branch its response to the measured elongation history.
-  Those the gauges cannot see at a start (string modes, LuGre bristle, pulley seat) carry
-  over from the previous segment's run instead.
+  Those the gauges cannot see at a start (string modes, LuGre bristle) carry over from
+  the previous segment's run instead. The pulley seat follows the recorded slack
+  episodes, at the start and inside every run (``kernel.measured_seats``).
 * The first segment starts at sample 0 from static rest, exactly as an open-loop run.
 
 Held-out cycles are then judged on segment predictions as well; that is fair because

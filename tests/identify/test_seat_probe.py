@@ -10,7 +10,7 @@ import pytest
 from drivers.signals import plan_motion
 from sim.config import StandConfig, default_config
 from sim.effects import EffectSpec
-from sim.identify.seat_probe import EFFECT, seat_probes
+from sim.identify.seat_probe import EFFECT, seat_probes, taut_law
 from sim.identify.traces import Trace, make_trace
 from sim.model import Model
 from sim.situations import SITUATIONS
@@ -93,9 +93,9 @@ def test_seat_steps_are_read_again_with_the_refits_own_baseline(stand: StandConf
     nominal = stand.stand_params("final", spec.mass_kg)
     base = fit(Candidate.build(), traces, nominal)
     candidate = Candidate.build(EFFECT)
-    start = effect_grid_start(
-        candidate, traces, nominal, base.values, seat_probes(traces, nominal, base.values)
-    )
+    probes = seat_probes(traces, nominal, base.values)
+    read_at_fit = [p for p in probes if "stiffness_scale" not in p]  # not the taut law's
+    start = effect_grid_start(candidate, traces, nominal, base.values, read_at_fit)
     first = _short_fit(candidate, traces, nominal, start)
     again = read_again(candidate, traces, nominal, first)
     assert again.train_cost < 0.5 * first.train_cost
@@ -104,3 +104,46 @@ def test_seat_steps_are_read_again_with_the_refits_own_baseline(stand: StandConf
     assert abs(again.values[f"{EFFECT}.step_m"] - step) < 0.1 * abs(step)
     # The other stand counts the seats, this candidate the steps up the flank.
     assert again.values[f"{EFFECT}.seats"] == truth[f"{EFFECT}.seats"] - 1
+    # The starts read with the taut intervals' own k and c (``taut_law``) reach the
+    # ratchet from the first fit.
+    both = effect_grid_start(candidate, traces, nominal, base.values, probes)
+    direct = _short_fit(candidate, traces, nominal, both)
+    assert direct.train_cost < 0.5 * first.train_cost
+    assert abs(direct.values[f"{EFFECT}.step_m"] - step) < 0.1 * abs(step)
+
+
+def test_the_taut_intervals_give_the_fibres_law_whatever_the_seat_did(
+    stand: StandConfig,
+) -> None:
+    # A stand 20 % stiffer and 30 % less damped than nominal, its fibre climbing a
+    # groove's flank in 0.5 mm steps once a slack loop is 0.5 mm deep. Between slack
+    # episodes the seat holds still, so the taut intervals give k and c (an intercept
+    # each), however the seat moved.
+    situation = SITUATIONS["11"]
+    t, x = plan_motion(situation.signal, stand.drive).sample(stand.sample_rate_hz)
+    nominal = stand.stand_params("final", situation.mass_kg)
+    real = dataclasses.replace(
+        nominal,
+        stiffness_n_m=1.2 * nominal.stiffness_n_m,
+        damping_n_s_m=0.7 * nominal.damping_n_s_m,
+    )
+    step = 5e-4
+    jump = EffectSpec(
+        EFFECT, {"step_m": step, "depth_scale_m": 1e-6, "seats": 3.0, "onset_m": 5e-4}
+    )
+    run = Model(real, [jump]).run(x, stand.sample_rate_hz)
+    force = run.force_n + np.random.default_rng(1).normal(0.0, NOISE_N, x.size)
+    trace = make_trace("11", t, x, run.u_m, force, situation.mass_kg)
+    law = taut_law([trace], nominal)
+    assert law is not None
+    assert law[0] == pytest.approx(1.2, rel=0.02)
+    assert law[1] == pytest.approx(0.7, rel=0.05)
+    # Read with a baseline that took the steps into k and c (as a fit without a seat
+    # does), the offsets show no clean step; the starts read with the taut law carry it
+    # and its k and c.
+    wrong = {"stiffness_scale": 0.6, "damping_scale": 4.0, "friction_scale": 1.0}
+    probes = seat_probes([trace], nominal, wrong)
+    lawful = [p for p in probes if "stiffness_scale" in p]
+    assert lawful
+    assert all(p["stiffness_scale"] == pytest.approx(law[0]) for p in lawful)
+    assert any(abs(p[f"{EFFECT}.step_m"] - step) < 0.1 * step for p in lawful)

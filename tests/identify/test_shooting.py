@@ -255,7 +255,10 @@ def test_chained_segments_equal_independent_ones_without_carried_states(
     outs = []
     for fn in (ek.simulate_segments_into, ek.simulate_chained_into):
         u, f = np.empty((2, 3, int(lengths.max()))), np.empty((2, 3, int(lengths.max())))
-        fn(rel, 1.0 / stand.sample_rate_hz, 1, rows, knots, coef, starts, lengths, init, u, f)
+        fn(
+            rel, 1.0 / stand.sample_rate_hz, 1, rows, knots, coef, starts, lengths, init, u, f,
+            np.zeros((2, 0)),
+        )  # fmt: skip
         outs.append((u, f))
     np.testing.assert_allclose(outs[1][0], outs[0][0], rtol=0, atol=1e-12)
     np.testing.assert_allclose(outs[1][1], outs[0][1], rtol=0, atol=1e-7)
@@ -544,3 +547,42 @@ def test_a_slow_force_gauge_restarts_where_the_recording_shows_it(
     # of the warm-up, and restarts cost 25× the open-loop error.
     restarted, open_loop = _restarted_and_open_loop_errors(stand, "force_gauge_dynamics", params)
     assert restarted < 1.5 * open_loop
+
+
+def test_a_segment_holds_the_pulley_seat_where_the_recorded_slack_put_it(
+    stand: StandConfig,
+) -> None:
+    # A taut fibre throughout (the heavy weight, slowly): the model's own slack never
+    # moves the seat. Given the seat the recorded episodes read (a step of 0.4 mm at
+    # one sample mid-segment), the run holds it there: nothing changes before that
+    # sample, and the fibre's tension jumps by about k·step right after it.
+    params = stand.stand_params("final", 8.131)
+    _, x = plan_motion(SLOW, stand.drive).sample(stand.sample_rate_hz)
+    rel = np.ascontiguousarray(x - x[0])
+    step, at = 4e-4, 1200
+    row = augmented_row(params, [EffectSpec("fibre_pulley_jump", {"step_m": step})])[None, :]
+    starts = np.array([0, 800], dtype=np.int64)
+    lengths = np.array([800, rel.size - 800], dtype=np.int64)
+    init = np.zeros((1, 2, ek.N_INIT))
+    run = Model(params).run(x, stand.sample_rate_hz)
+    assert run.force_n.min() > 0.3 * params.preload_tension_n  # never slack
+    init[0, 1, ek.I_U], init[0, 1, ek.I_V] = run.u_m[800], run.v_m_s[800]
+    init[0, 1, ek.I_F] = run.force_n[800]
+    knots, coef = friction_arrays(params.friction)
+    seat = np.zeros((1, rel.size))
+    seat[0, at:] = step
+    width = int(lengths.max())
+    outs = []
+    for seats in (np.zeros((1, 0)), np.zeros((1, rel.size)), seat):
+        u, f = np.empty((1, 2, width)), np.empty((1, 2, width))
+        ek.simulate_segments_serial(
+            rel, 1.0 / stand.sample_rate_hz, 1, row, knots, coef, starts, lengths, init, u, f,
+            seats,
+        )  # fmt: skip
+        outs.append(f[0, 1])
+    model_own, at_rest, stepped = outs
+    np.testing.assert_array_equal(model_own, at_rest)  # never slack: the seat stayed
+    k = at - starts[1]
+    np.testing.assert_array_equal(stepped[: k - 1], at_rest[: k - 1])
+    jump = stepped[k] - at_rest[k]
+    assert jump == pytest.approx(params.stiffness_n_m * step, rel=0.3)
