@@ -134,7 +134,7 @@ def make_campaign(
     truth: str,
     mass_kg: float,
     rng: np.random.Generator,
-    campaign: Sequence[tuple[str, SignalSpec]] = FULL_CAMPAIGN,
+    campaign: Sequence[tuple[str, SignalSpec] | OtherRecording] = FULL_CAMPAIGN,
     open_loop_oracle: bool = False,
     truth_stand: str = "same",
     other_campaign: Sequence[OtherRecording] = OTHER_FULL,
@@ -164,8 +164,13 @@ def make_campaign(
         params = dict(spec.params)
     noise = NoiseSpec.draw(rng)
     traces, oracle = [], []
-    for name, signal in campaign:
-        t, x = plan_motion(signal, stand.drive).sample(stand.sample_rate_hz)
+    for item in campaign:
+        name, signal, limits = (
+            (item.name, item.signal, item.limits)
+            if isinstance(item, OtherRecording)
+            else (item[0], item[1], stand.drive)
+        )
+        t, x = plan_motion(signal, limits).sample(stand.sample_rate_hz)
         run = Model(real, effects).run(x, stand.sample_rate_hz)
         gauges = MeasurementNoise(noise, stand.sample_rate_hz, rng)
         u_rec, f_rec = gauges.apply(run.u_m, run.force_n)
