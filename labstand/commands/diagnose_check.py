@@ -32,9 +32,9 @@ if TYPE_CHECKING:  # imported where they run: `diagnose-check --help` loads no n
 # Literal copies of sim.identify.check's TRUTHS and MASSES_KG, which imports numba: the
 # parser is built without it (tests/core/test_cli_startup.py checks that they agree).
 TRUTHS = ("same", "other")
-#: The other stand's recording sets (``sim.otherstand.campaign.OTHER_SETS``, not imported
-#: here: ``--help`` loads no numba).
-RECORDING_SETS = ("moderate", "gentle", "brisk")
+#: The check's recording sets (``sim.identify.check.RECORDING_SETS``, not imported here:
+#: ``--help`` loads no numba).
+RECORDING_SETS = ("moderate", "gentle", "brisk", "paper")
 MASSES_KG = (3.096, 8.131)
 
 LABEL = "labstand diagnose-check"
@@ -45,8 +45,9 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     parser = sub.add_parser(
         "diagnose-check",
         description="For every effect and for 'none', at both weight masses, draw a real-like "
-        "stand (±25 % mismatch), a random effect magnitude and realistic noise, simulate a "
-        "quick, a medium and a slow recording, diagnose them blind, and score the answers.",
+        "stand (±25 % mismatch), a random effect magnitude and realistic noise, simulate the "
+        "validation campaigns' four recordings (quick, rectangle, slack-making burst, slow; "
+        "--recordings for others), diagnose them blind, and score the answers.",
     )
     add_stand_options(parser)
     parser.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
@@ -88,9 +89,10 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     parser.add_argument(
         "--recordings",
         choices=RECORDING_SETS,
-        help="with --truth other: the drive signals recorded per campaign: 'moderate' "
+        help="the drive signals recorded per campaign, for either truth: 'moderate' "
         "(default: the validation campaigns' four), 'gentle' (three, small and slow, the "
-        "fibre never slack) or 'brisk' (four, quicker and larger, mostly slack)",
+        "fibre never slack), 'brisk' (four, quicker and larger, mostly slack) or 'paper' "
+        "(the first checks' paper-like quick, medium and slow recordings, ~22 s)",
     )
     parser.add_argument("--json", action="store_true", help="print JSON (accuracy, confusion, ...)")
     parser.add_argument("-o", "--output", type=Path, help="also write the JSON here")
@@ -109,7 +111,7 @@ class CheckSetup:
     """What every campaign of a check shares (shipped to the workers with each job)."""
 
     stand: StandConfig
-    campaign: tuple[tuple[str, SignalSpec], ...]
+    campaign: tuple[tuple[str, SignalSpec] | OtherRecording, ...]
     truth_stand: str
     other_campaign: tuple[OtherRecording, ...]
 
@@ -183,11 +185,9 @@ def _pairs(args: argparse.Namespace) -> list[tuple[str, str]]:
 
 
 def _recording_set(args: argparse.Namespace) -> str:
-    """The other stand's recording set asked for (CommandError, exit 2, if it cannot be)."""
+    """The recording set asked for (CommandError, exit 2, if it cannot be)."""
     if args.recordings is None:
         return "small" if args.small else "moderate"
-    if args.truth != "other":
-        raise CommandError("--recordings needs --truth other", ExitCode.USAGE)
     if args.small:
         raise CommandError("--recordings and --small are two sets: give one", ExitCode.USAGE)
     return str(args.recordings)
@@ -196,17 +196,20 @@ def _recording_set(args: argparse.Namespace) -> str:
 def run(args: argparse.Namespace) -> int:
     """Run the check and report."""
     from labstand.campaign_table import campaign_row, write_results
-    from sim.identify.check import CLASSES, FULL_CAMPAIGN, SMALL_CAMPAIGN, check_cases, score
-    from sim.otherstand.campaign import OTHER_SETS
+    from sim.identify.check import CLASSES, SMALL_CAMPAIGN, check_cases, recording_set, score
+    from sim.otherstand.campaign import OTHER_SMALL
 
     stand = load_stand(args)
     classes = _classes(args)
     pairs = _pairs(args)
     options = ClusterOptions.from_args(args)
     recordings = _recording_set(args)
-    setup = CheckSetup(
-        stand, SMALL_CAMPAIGN if args.small else FULL_CAMPAIGN, args.truth, OTHER_SETS[recordings]
-    )
+    # Both truths record the same drive signals (``--small``: each its own short pair).
+    if recordings == "small":
+        setup = CheckSetup(stand, SMALL_CAMPAIGN, args.truth, OTHER_SMALL)
+    else:
+        chosen = recording_set(recordings, stand)
+        setup = CheckSetup(stand, chosen, args.truth, chosen)
     specs = check_cases(
         args.seed, args.trials, CLASSES if classes is None else classes, args.mass_kg, pairs
     )
@@ -216,8 +219,7 @@ def run(args: argparse.Namespace) -> int:
     out = result.to_dict()
     out["seed"] = args.seed
     out["truth"] = args.truth
-    if args.truth == "other":
-        out["recordings"] = recordings
+    out["recordings"] = recordings
     failed = [r for r in results if r.value is None]
     if failed:
         out["failed"] = [{"name": r.key, "error": r.error, "worker": r.worker} for r in failed]

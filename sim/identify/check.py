@@ -5,9 +5,11 @@ Each campaign is generated, diagnosed without its answer, and the answer scored.
 For every effect and for ``none``, at each weight mass, a campaign is drawn: a "real"
 stand (stiffness, damping and friction scale off nominal by up to ±25 %), the effect at
 a random magnitude within its plausible range, realistic gauge noise, hum and
-quantisation, and noise on the drive encoder too. Three recordings — a quick, a medium
-and a slow drive motion — are simulated with that truth. The diagnosis sees only the
-recordings (as DataFrames, like files read back) and the nominal stand.
+quantisation, and noise on the drive encoder too. Its recordings are simulated with that
+truth: ``campaign``, the paper-like quick, medium and slow motions by default here, or a
+named set (``recording_set``: the CLI's default is the validation campaigns' four, for
+either truth). The diagnosis sees only the recordings (as DataFrames, like files read
+back) and the nominal stand.
 
 ``truth_stand``: ``"same"`` draws the truth from the candidate models themselves (as
 above); ``"other"`` from ``sim.otherstand``, an independently written stand with a second
@@ -40,7 +42,7 @@ from sim.identify.report import Diagnosis
 from sim.identify.shooting import dial_slope
 from sim.identify.traces import Trace, make_trace
 from sim.model import Model
-from sim.otherstand.campaign import OTHER_FULL, OtherRecording
+from sim.otherstand.campaign import OTHER_FULL, OTHER_SETS, OtherRecording
 from sim.params import StandParams
 
 log = logging.getLogger(__name__)
@@ -66,6 +68,24 @@ SMALL_CAMPAIGN = (
     ),
     ("slow", SignalSpec(Shape.QUASI_SINUSOIDAL, 0.060, 0.5, cycles=2, dwell_end_s=0.5)),
 )
+
+
+#: A campaign's recordings: (name, signal) under the stand's drive limits, or the other
+#: stand's recordings (signal and limits each; ``sim.otherstand.campaign.OTHER_SETS``).
+CampaignSpec = Sequence[tuple[str, SignalSpec] | OtherRecording]
+#: The recording sets a check can draw its campaigns with (``recording_set``): the other
+#: stand's (the validation campaigns' four drive signals are ``moderate``), and the
+#: paper-like quick, medium and slow recordings the first checks used.
+RECORDING_SETS = ("moderate", "gentle", "brisk", "paper")
+
+
+def recording_set(name: str, stand: StandConfig) -> tuple[OtherRecording, ...]:
+    """A named set of drive signals, for either truth (ValueError if unknown)."""
+    if name == "paper":
+        return tuple(OtherRecording(n, signal, stand.drive) for n, signal in FULL_CAMPAIGN)
+    if name in OTHER_SETS:
+        return OTHER_SETS[name]
+    raise ValueError(f"unknown recording set {name!r}; known: {', '.join(RECORDING_SETS)}")
 
 
 @dataclass(frozen=True)
@@ -134,7 +154,7 @@ def make_campaign(
     truth: str,
     mass_kg: float,
     rng: np.random.Generator,
-    campaign: Sequence[tuple[str, SignalSpec] | OtherRecording] = FULL_CAMPAIGN,
+    campaign: CampaignSpec = FULL_CAMPAIGN,
     open_loop_oracle: bool = False,
     truth_stand: str = "same",
     other_campaign: Sequence[OtherRecording] = OTHER_FULL,
@@ -260,7 +280,7 @@ def check_cases(
 def diagnose_case(
     stand: StandConfig,
     spec: CaseSpec,
-    campaign: Sequence[tuple[str, SignalSpec]] = FULL_CAMPAIGN,
+    campaign: CampaignSpec = FULL_CAMPAIGN,
     truth_stand: str = "same",
     other_campaign: Sequence[OtherRecording] = OTHER_FULL,
 ) -> tuple[Case | PairCase, Diagnosis]:
@@ -327,7 +347,7 @@ def run_check(
     trials: int = 1,
     classes: Sequence[str] = CLASSES,
     masses: Sequence[float] = MASSES_KG,
-    campaign: Sequence[tuple[str, SignalSpec]] = FULL_CAMPAIGN,
+    campaign: CampaignSpec = FULL_CAMPAIGN,
     progress: Callable[[str], None] | None = None,
     truth_stand: str = "same",
     other_campaign: Sequence[OtherRecording] = OTHER_FULL,

@@ -16,7 +16,7 @@ from drivers.limits import DriveLimits
 from drivers.signals import Shape, SignalSpec, plan_motion
 from labstand.cli import main
 from sim.config import StandConfig
-from sim.identify.check import make_campaign
+from sim.identify.check import FULL_CAMPAIGN, make_campaign, recording_set
 from sim.otherstand import OTHER_EFFECTS, OTHER_PAIRS, simulate
 from sim.otherstand import _kernel as kern
 from sim.otherstand.campaign import OTHER_SETS, OTHER_SMALL, make_other_campaign
@@ -360,9 +360,35 @@ def test_cli_writes_the_truth_into_its_json(tmp_path: Path) -> None:
     assert json.loads(out.read_text())["recordings"] == "brisk"
 
 
-def test_cli_refuses_a_recording_set_it_cannot_use(capsys: pytest.CaptureFixture[str]) -> None:
-    assert main(["diagnose-check", "--recordings", "gentle", "--effects"]) == 2
-    assert "--recordings needs --truth other" in capsys.readouterr().err
+def test_cli_refuses_a_recording_set_it_cannot_use(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    # Either truth records any set (the same drive signals for both); the paper-like
+    # recordings of the first checks are one of them.
+    out = tmp_path / "check.json"
+    assert main(["diagnose-check", "--recordings", "paper", "--effects", "-o", str(out)]) == 0
+    assert json.loads(out.read_text())["recordings"] == "paper"
+    with pytest.raises(SystemExit):  # argparse's own refusal, exit 2
+        main(["diagnose-check", "--recordings", "faster", "--effects"])
+    assert "invalid choice" in capsys.readouterr().err
     both = ["diagnose-check", "--truth", "other", "--recordings", "gentle", "--small"]
     assert main([*both, "--effects"]) == 2
     assert "give one" in capsys.readouterr().err
+
+
+def test_both_truths_record_the_same_drive_signals(stand: StandConfig) -> None:
+    # The same-form truth on the validation campaigns' four recordings: the drive is the
+    # other stand's, signal and limits alike (the rectangle at 0.3 m/s and 3 m/s²).
+    moderate = recording_set("moderate", stand)
+    assert moderate == OTHER_SETS["moderate"]
+    traces, _, _ = make_campaign(stand, "none", HEAVY, np.random.default_rng(2), moderate)
+    assert [t.name for t in traces] == [r.name for r in moderate]
+    for trace, rec in zip(traces, moderate, strict=True):
+        _, x = plan_motion(rec.signal, rec.limits).sample(stand.sample_rate_hz)
+        assert trace.x_m.size == x.size
+        assert np.max(np.abs(trace.x_m - x)) < 1e-5  # the drive encoder's noise, 1 µm rms
+    paper = recording_set("paper", stand)
+    assert [(r.name, r.signal) for r in paper] == list(FULL_CAMPAIGN)
+    assert all(r.limits == stand.drive for r in paper)
+    with pytest.raises(ValueError, match="unknown recording set"):
+        recording_set("faster", stand)
