@@ -126,7 +126,8 @@ def taut_law(traces: Sequence[Trace], nominal: StandParams) -> tuple[float, floa
         # Intervals are runs of taut training samples: a dip of the smoothed force that
         # never reads as slack may still have let the seat move (a snap at the least
         # slack), and an interval split there costs one more intercept, not a bias.
-        use = ch.taut & trace.train
+        finite = np.isfinite(ch.stretch) & np.isfinite(ch.rate) & np.isfinite(ch.force)
+        use = ch.taut & trace.train & finite  # a lost sample cuts an interval too
         edges = np.flatnonzero(np.diff(use.astype(np.int8))) + 1
         for held in np.split(np.arange(use.size), edges):
             if not use[held[0]] or held.size < min_taut:
@@ -137,8 +138,6 @@ def taut_law(traces: Sequence[Trace], nominal: StandParams) -> tuple[float, floa
     if len(rows) < 2:
         return None
     design, force = np.concatenate(rows), np.concatenate(forces)
-    if not np.all(np.isfinite(design)) or not np.all(np.isfinite(force)):
-        return None
     (k, c), *_ = np.linalg.lstsq(design, force, rcond=None)
     if not (k > 0 and c > 0):
         return None
