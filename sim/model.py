@@ -242,7 +242,7 @@ class Model:
         """
         x_rel = check_input(x_m, rate_hz)
         base, rows = self._rows(variants, augmented=True)  # the start states need them
-        init, seats = _starts.start_states_and_seats(
+        init, seats = _starts.start_states(
             rows, x_rel, rate_hz, restarts.starts, restarts.u_m, restarts.v_m_s,
             restarts.force_n, restarts.dial_slope,
         )  # fmt: skip

@@ -13,6 +13,8 @@ kernel (``kernel.measured_state``) or carried between segments.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -24,7 +26,18 @@ from sim.effects.registry import EFFECTS
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
 
-__all__ = ["start_states", "start_states_and_seats"]
+__all__ = ["StartStates", "start_states"]
+
+
+class StartStates(NamedTuple):
+    """What the segment runs of a batch start from."""
+
+    #: (sets, segments, ek.N_INIT): each segment's measured start (columns ek.I_*).
+    init: FloatArray
+    #: (sets, samples): each row's pulley-seat offset at every sample, as the recorded
+    #: slack episodes put it (``fibre_pulley_jump.recorded_seat``; 0 where the row has no
+    #: pulley jump), or (sets, 0) if no row has one (every run's seat is the model's).
+    seats: FloatArray
 
 
 def start_states(
@@ -36,32 +49,11 @@ def start_states(
     v_m_s: FloatArray,
     force_n: FloatArray,
     dial_slope: float = float("nan"),
-) -> FloatArray:
-    """Measured start states (sets, segments, ek.N_INIT) for augmented kernel rows.
+) -> StartStates:
+    """Measured start states for augmented kernel rows, and their recorded seats.
 
     ``u_m``, ``v_m_s``, ``force_n``: the recorded channels (smoothed) at every sample;
     ``dial_slope``: du_rec/dx at constant force (NaN: take the gauge's scale as 1).
-    """
-    return start_states_and_seats(rows, x_rel_m, rate_hz, starts, u_m, v_m_s, force_n, dial_slope)[
-        0
-    ]
-
-
-def start_states_and_seats(
-    rows: FloatArray,
-    x_rel_m: FloatArray,
-    rate_hz: float,
-    starts: IntArray,
-    u_m: FloatArray,
-    v_m_s: FloatArray,
-    force_n: FloatArray,
-    dial_slope: float = float("nan"),
-) -> tuple[FloatArray, FloatArray]:
-    """``start_states``, and the pulley seat the recorded slack puts each row in.
-
-    The seats: (sets, samples), each row's seat offset at every sample
-    (``fibre_pulley_jump.recorded_seat``; 0 where the row has no pulley jump), or
-    (sets, 0) if no row has one (every run's seat is then the model's).
     """
     rows2 = np.atleast_2d(rows)
     init = np.zeros((rows2.shape[0], starts.size, ek.N_INIT))
@@ -87,7 +79,7 @@ def start_states_and_seats(
                 info.start_state(row, measured, starts, init[b])
         if jumps[b]:
             seats[b] = recorded_seat(row, measured)
-    return init, seats
+    return StartStates(init, seats)
 
 
 def _transform_key(row: FloatArray, on: list[EffectInfo]) -> bytes:

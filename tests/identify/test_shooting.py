@@ -137,13 +137,16 @@ def test_restarts_take_the_displacement_on_the_dial_gauges_own_scale(
     seg = segment_trace(tr)
     row = augmented_row(p)[None, :]
     x_rel = tr.x_m - tr.x_m[0]
-    init = start_states(row, x_rel, tr.rate_hz, seg.starts, seg.u_m, seg.v_m_s, seg.force_n, slope)
+    init = start_states(
+        row, x_rel, tr.rate_hz, seg.starts, seg.u_m, seg.v_m_s, seg.force_n, slope
+    ).init
     expected = seg.u_m[seg.starts] / (slope * p.projection)
     np.testing.assert_allclose(init[0, :, ek.I_U], expected)
     # Without the campaign's estimate (a lone quick trace has too few calm samples) the
     # reading is taken at face value.
     if not np.isfinite(seg.dial_slope):
-        init = start_states(row, x_rel, tr.rate_hz, seg.starts, seg.u_m, seg.v_m_s, seg.force_n)
+        channels = (seg.starts, seg.u_m, seg.v_m_s, seg.force_n)
+        init = start_states(row, x_rel, tr.rate_hz, *channels).init
         np.testing.assert_allclose(init[0, :, ek.I_U], seg.u_m[seg.starts])
 
 
@@ -161,9 +164,9 @@ def test_rows_of_one_batch_get_the_start_states_each_would_get_alone(stand: Stan
         + [augmented_row(p, [EffectSpec("fibre_viscoelastic")])]
     )
     args = (x_rel, tr.rate_hz, seg.starts, seg.u_m, seg.v_m_s, seg.force_n, 1.01 / p.projection)
-    together = start_states(rows, *args)
+    together = start_states(rows, *args).init
     for b, row in enumerate(rows):
-        np.testing.assert_array_equal(together[b], start_states(row[None, :], *args)[0])
+        np.testing.assert_array_equal(together[b], start_states(row[None, :], *args).init[0])
     # The skewed rows start elsewhere than the plain one, and apart from each other.
     assert not np.array_equal(together[1, :, ek.I_F], together[0, :, ek.I_F])
     assert not np.array_equal(together[1, :, ek.I_F], together[2, :, ek.I_F])
