@@ -221,7 +221,7 @@ def simulate_augmented_segments(
     held past its end. ``serial``: on the calling thread, without the GIL (several
     traces side by side) instead of on all cores. ``seats`` (sets, samples): the pulley
     seat's offset each row's runs hold at every sample, as the recorded slack episodes
-    put it (``_starts.start_states_and_seats``); None: the model's own slack moves it.
+    put it (``_starts.start_states``); None: the model's own slack moves it.
     """
     rows2 = np.ascontiguousarray(np.atleast_2d(rows), dtype=np.float64)
     sets, segs, width = rows2.shape[0], starts.shape[0], int(lengths.max())
