@@ -139,6 +139,9 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _print_summary(result: Diagnosis, report: Path | None) -> None:
+    from sim.identify.remainder import VERDICT_WORDS
+
+    print(f"Verdict: {VERDICT_WORDS.get(result.verdict, result.verdict)}")
     print(f"Effect: {result.effect}")
     for e in result.effects:
         notes = []
@@ -154,6 +157,17 @@ def _print_summary(result: Diagnosis, report: Path | None) -> None:
         print(f"  {e.effect}: closes {e.closure:.0%} of the gap (p = {e.p_value:.2g}); {params}")
         for note in notes:
             print(f"    {note}")
+    for effect, kind in result.displaced.items():
+        print(f"  {effect}: passed its test but did no better than a {kind} term (not named)")
+    rem = result.remainder
+    if rem is not None:
+        state = "beyond the noise" if rem.beyond_noise else "within what the noise allows"
+        print(
+            f"Remainder: {state} (p = {rem.p_value:.2g}); held-out error {rem.excess:.2f} × "
+            f"noise, {rem.share_of_gap:.0%} of the baseline's gap"
+        )
+        for sig in [s for s in rem.signature if s.passes][:3]:
+            print(f"  {sig.kind} in {sig.channel}: closes {sig.closes:.0%}; {sig.formula}")
     print("Held-out gap        before            after")
     for ch in ("u", "F"):
         b, a = result.gap_before[ch], result.gap_after[ch]

@@ -50,6 +50,7 @@ from sim.identify.heldout import (
     heldout_excess,
     noise_floor,
 )
+from sim.identify.remainder import judge_signatures, remainder_of, verdict
 from sim.identify.report import AcceptedEffect, Diagnosis, RankedEffect
 from sim.identify.screening import outputs_of, screen
 from sim.identify.seat_probe import EFFECT as SEAT_EFFECT
@@ -285,7 +286,9 @@ def diagnose(
     ranking = _ranking(order, scores, refits, evidence, x_base, traces)
 
     accepted: list[AcceptedEffect] = []
+    displaced: dict[str, str] = {}
     after_out = base_out
+    after_values = base_values
     confidence = 0.0
     chosen = strongest_accepted(ranking, evidence, len(refits))
     best = chosen or (ranking[0].effect if ranking else None)
@@ -293,7 +296,14 @@ def diagnose(
         confidence = bootstrap_confidence(
             cycle_improvements(traces, base_out, refits[best].outputs)
         )
-    if best is not None and evidence[best].accepted(len(refits)):
+    if chosen is not None:
+        started = time.perf_counter()
+        rival = signature_rival(traces, base_out, nominal, base_values, refits[chosen].outputs)
+        timings["signature_check"] = time.perf_counter() - started
+        if rival is not None:
+            say(f"{chosen} does no better than a {rival} term: not named")
+            displaced[chosen] = rival
+    if best is not None and best not in displaced and evidence[best].accepted(len(refits)):
         say(f"polishing {best}")
         started = time.perf_counter()
         current = _polish(refits[best], traces, nominal)
@@ -319,9 +329,17 @@ def diagnose(
         sims += second_sims
         timings["second_effect"] = time.perf_counter() - started
         if second is not None:
-            accepted.append(second[0])
-            current = second[1]
+            rival = signature_rival(
+                traces, current.outputs, nominal, current.result.values, second[1].outputs
+            )
+            if rival is None:
+                accepted.append(second[0])
+                current = second[1]
+            else:
+                say(f"{second[0].effect} does no better than a {rival} term: not named")
+                displaced[second[0].effect] = rival
         after_out = current.outputs
+        after_values = current.result.values
     x_after = heldout_excess(traces, after_out)
 
     # The fitted baseline as the fit saw it (segments from measured states): an
@@ -330,6 +348,17 @@ def diagnose(
         SimStates(o.u_m, o.force_n, np.gradient(o.u_m, 1.0 / tr.rate_hz))
         for tr, o in zip(traces, base_out, strict=True)
     ]
+    say("judging what remains")
+    started = time.perf_counter()
+    after_states = [
+        SimStates(o.u_m, o.force_n, np.gradient(o.u_m, 1.0 / tr.rate_hz))
+        for tr, o in zip(traces, after_out, strict=True)
+    ]
+    remainder = remainder_of(
+        traces, after_out, nominal, after_values, x_base,
+        where_the_gap_lies(traces, after_states),
+    )  # fmt: skip
+    timings["remainder"] = time.perf_counter() - started
     timings["total"] = time.perf_counter() - t0
     return Diagnosis(
         effects=accepted,
@@ -347,7 +376,38 @@ def diagnose(
         simulations=sims,
         outputs_before=base_out,
         outputs_after=after_out,
+        verdict=verdict(bool(accepted), remainder),
+        remainder=remainder,
+        displaced=displaced,
     )
+
+
+def signature_rival(
+    traces: Sequence[Trace],
+    before: Sequence[Outputs],
+    nominal: StandParams,
+    values: dict[str, float],
+    effect: Sequence[Outputs],
+) -> str | None:
+    """The kind of library term that does at least as well as an effect, or None.
+
+    A catalogue effect that fits a gap of another kind closes part of it (a gauge's gain
+    soaks up a drifting force offset): it is named only if no signature of the remainder
+    (``signature``) that is itself evidence does as well. The effect stands if it beats
+    the best such signature on the held-out cycles (``beats``), or if neither beats the
+    other and the effect's held-out error is the lower.
+    """
+    signatures, fits, _ = judge_signatures(traces, before, nominal, values)
+    passing = [s for s in signatures if s.passes]
+    if not passing:
+        return None
+    best = passing[0]  # the lowest held-out error among those that pass
+    rival = fits[best.kind].outputs
+    if beats(traces, effect, rival):
+        return None
+    if not beats(traces, rival, effect) and heldout_excess(traces, effect) <= best.excess_after:
+        return None
+    return best.kind
 
 
 def strongest_accepted(

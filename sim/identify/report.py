@@ -7,6 +7,7 @@ from typing import Any
 
 from sim.identify.decide import ALPHA
 from sim.identify.heldout import Outputs
+from sim.identify.remainder import Remainder
 from sim.identify.where import Where
 
 __all__ = ["AcceptedEffect", "ChannelGap", "Diagnosis", "RankedEffect"]
@@ -103,6 +104,12 @@ class Diagnosis:
     simulations: int = 0
     outputs_before: list[Outputs] = field(default_factory=list, repr=False)
     outputs_after: list[Outputs] = field(default_factory=list, repr=False)
+    #: One of ``remainder.VERDICTS``: what the named effects leave.
+    verdict: str = "baseline_adequate"
+    remainder: Remainder | None = None
+    #: Effects that passed their test but did no better than a signature of the
+    #: remainder (effect → the signature's kind): not named.
+    displaced: dict[str, str] = field(default_factory=dict)
 
     @property
     def effect(self) -> str:
@@ -113,7 +120,10 @@ class Diagnosis:
         """JSON keys: effect, effects, ranking, where, gap_before, gap_after, and details."""
         return {
             "effect": self.effect,
+            "verdict": self.verdict,
             "effects": [e.to_dict() for e in self.effects],
+            "remainder": self.remainder.to_dict() if self.remainder is not None else None,
+            "displaced": self.displaced,
             "ranking": [r.to_dict() for r in self.ranking],
             "where": self.where.to_dict(),
             "gap_before": self.gap_before,

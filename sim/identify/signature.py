@@ -1,0 +1,444 @@
+"""What a remainder behaves like: a sparse regression on a library of physical terms.
+
+After the named effects (or the baseline alone) a remainder may stand. Its *signature*
+says which kind of term the model lacks, from the recordings: each kind is a small
+library of candidate terms, fitted to the training cycles' remainder and judged on the
+held-out ones, like every effect.
+
+A term acts where it would act on the stand (its *route*):
+
+* ``weight``: a force on the weight (a bump on the guide, a drag law). It enters the
+  outputs through the stand's taut dynamics, linearised at the fitted k and c:
+  δu = H·f, δF = −n(k + c·s)·H·f with H = 1/(m·s² + n²c·s + n²k);
+* ``tension``: a tension the fibre law lacks (a strain-stiffening fibre, an eccentric
+  pulley's length change): δu = n·H·g, δF = g − n²(k + c·s)·H·g;
+* ``u`` or ``F``: a term in one gauge's reading only (a sensor: drift, nonlinearity).
+
+The filters restart from rest at every shooting segment's start, as the model's runs
+restart from measured states (``shooting``): a missing term's output error grows from
+zero within each run exactly as the model's own does.
+
+The kinds (``KINDS``) are position (polynomial in the weight's position, periodic in the
+pulley's turn), strain (powers of the fibre's tension beyond linear), velocity (friction
+and drag shapes of the weight's speed), resonance (a damped mode excited by the
+tension), drift (slow polynomials in time within each recording), and ``other``: the
+remainder of the training cycles, averaged cycle by cycle, predicting the held-out
+cycles' — it repeats with the motion, yet no term of the library describes it.
+
+Each kind is fitted by sequentially thresholded least squares (STLSQ, the optimiser of
+SINDy; Brunton, Proctor and Kutz 2016), on columns scaled to their output's noise so the
+threshold is in noise units: a term that moves the outputs by less than
+``THRESHOLD_NOISE`` of the noise is dropped.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.signal import cont2discrete, lfilter
+
+from sim.identify.heldout import Outputs, _noise_scale
+from sim.identify.traces import Trace
+from sim.params import StandParams
+
+FloatArray = NDArray[np.float64]
+
+__all__ = ["KINDS", "Signature", "SignatureFit", "fit_signatures"]
+
+#: The kinds of term a remainder can be described by (``other``: repeats, no formula).
+KINDS = ("position", "strain", "velocity", "resonance", "drift", "other")
+#: STLSQ drops a term whose scaled coefficient (noise units of the outputs it moves,
+#: rms over the training samples) is below this.
+THRESHOLD_NOISE = 0.2
+#: STLSQ rounds (pysindy's default is 20; the support settles in a few).
+STLSQ_ROUNDS = 10
+#: Ridge on the scaled columns (relative to the largest eigenvalue): libraries of
+#: neighbouring frequencies or speeds are nearly collinear.
+RIDGE = 1e-6
+#: Natural frequencies of the resonance library, Hz, and its damping ratio.
+RESONANCE_HZ = (15.0, 25.0, 40.0, 60.0, 90.0, 140.0, 220.0, 350.0)
+RESONANCE_ZETA = 0.05
+#: Speeds at which the velocity library's friction shapes saturate, m/s.
+VELOCITY_SCALES_M_S = (1e-3, 1e-2)
+#: Polynomial orders of the drift library (per recording and gauge).
+DRIFT_ORDERS = (0, 1, 2, 3)
+
+Route = str  # "weight", "tension", "u" or "F"
+#: A discrete filter's (numerator, denominator).
+Filter = tuple[FloatArray, FloatArray]
+
+
+@dataclass(frozen=True)
+class Term:
+    """One library term: its kind, where it acts (``Route``), a readable name, its unit."""
+
+    kind: str
+    route: Route
+    name: str
+    unit: str
+
+
+@dataclass(frozen=True)
+class Signature:
+    """A kind of term that describes the remainder: its formula and what it closes."""
+
+    kind: str
+    channel: str  # "u", "F", or "u+F" (a physical term shows in both)
+    formula: str
+    #: Share of the remainder above the noise (X − 1) it closes on held-out cycles.
+    closes: float
+    excess_after: float
+    p_family: float = 1.0
+    passes: bool = False
+
+    def to_dict(self) -> dict[str, object]:
+        """JSON keys kind, channel, formula, closes, excess_after, p_value, passes."""
+        return {
+            "kind": self.kind,
+            "channel": self.channel,
+            "formula": self.formula,
+            "closes": self.closes,
+            "excess_after": self.excess_after,
+            "p_value": self.p_family,
+            "passes": self.passes,
+        }
+
+
+@dataclass
+class SignatureFit:
+    """A kind fitted to a remainder: the adjusted outputs and what they say."""
+
+    kind: str
+    outputs: list[Outputs]
+    channel: str
+    formula: str
+    #: The fitted terms' predicted remainder per trace (u, F), for plots.
+    predicted: list[Outputs]
+
+
+def _taut_filters(
+    mass_kg: float, nominal: StandParams, values: dict[str, float], rate_hz: float
+) -> dict[str, tuple[Filter, Filter]]:
+    """Discrete (u, F) responses to a unit force on the weight and a unit extra tension."""
+    n = nominal.projection
+    k = nominal.stiffness_n_m * values.get("stiffness_scale", 1.0)
+    c = nominal.damping_n_s_m * values.get("damping_scale", 1.0)
+    den = [mass_kg, n * n * c, n * n * k]
+    systems = {
+        "weight": ([1.0], np.polymul([-n * c, -n * k], [1.0])),
+        "tension": ([n], np.polyadd([mass_kg, 0.0, 0.0], [0.0, 0.0, 0.0])),
+    }
+    out = {}
+    for route, (num_u, num_f) in systems.items():
+        pair = []
+        for num in (num_u, num_f):
+            b, a, _ = cont2discrete((np.asarray(num, float), np.asarray(den, float)),
+                                    1.0 / rate_hz, method="bilinear")  # fmt: skip
+            pair.append((np.ravel(b), np.ravel(a)))
+        out[route] = (pair[0], pair[1])
+    return out
+
+
+def _through_runs(
+    trace: Trace, series: FloatArray, ba: tuple[FloatArray, FloatArray]
+) -> FloatArray:
+    """Causal filters run from rest in every shooting segment, read where each is scored.
+
+    ``series``: (terms, samples); the result has the same shape.
+    """
+    seg = trace.segments
+    out = np.zeros_like(series)
+    for k in range(seg.count):
+        start, length = int(seg.starts[k]), int(seg.lengths[k])
+        run = lfilter(ba[0], ba[1], series[:, start : start + length], axis=1)
+        lo, hi = int(seg.body[k]), int(seg.body[k + 1]) if k + 1 < seg.count else trace.samples
+        out[:, lo:hi] = run[:, seg.offset[lo:hi]]
+    return out
+
+
+class _Library:
+    """The terms of every kind, with the campaign-wide scales that make them readable."""
+
+    def __init__(
+        self, traces: Sequence[Trace], outputs: Sequence[Outputs], nominal: StandParams
+    ) -> None:
+        self.traces = traces
+        self.outputs = outputs
+        self.u_span = max([float(np.ptp(tr.segments.u_m)) for tr in traces] + [1e-6])
+        self.v_top = max([float(np.max(np.abs(tr.segments.v_m_s))) for tr in traces] + [1e-6])
+        tension = np.concatenate([o.force_n for o in outputs])
+        self.t_ref = float(np.median(tension)) or 1.0
+        self.radius = nominal.pulley_radius_m
+
+    def terms(self, kind: str) -> list[Term]:
+        """The kind's terms, in the order ``series`` gives them."""
+        span, v, t = f"{self.u_span * 1e3:.3g} mm", f"{self.v_top:.3g} m/s", f"{self.t_ref:.3g} N"
+        if kind == "position":  # the guide (Legendre in u), a gauge, the pulley's turn
+            return [
+                *(Term(kind, "weight", f"P{k}(u/{span})", "N") for k in (1, 2, 3)),
+                *(Term(kind, "u", f"P{k}(u/{span})", "m") for k in (2, 3)),
+                *(Term(kind, "tension", f"{fn}({h}·x/r)", "N") for h in (1, 2)
+                  for fn in ("sin", "cos")),
+            ]  # fmt: skip
+        if kind == "strain":  # the fibre's law beyond linear
+            return [Term(kind, "tension", f"(T/{t})^{p}", "N") for p in (2, 3)]
+        if kind == "velocity":  # viscous, drag, Coulomb-like shapes
+            return [
+                Term(kind, "weight", f"v/{v}", "N"),
+                Term(kind, "weight", f"v·|v|/({v})²", "N"),
+                *(Term(kind, "weight", f"tanh(v/{s:g} m/s)", "N") for s in VELOCITY_SCALES_M_S),
+            ]
+        if kind == "resonance":  # the tension through a damped mode, as a force or a reading
+            return [
+                Term(kind, route, f"mode {hz:g} Hz (ζ {RESONANCE_ZETA:g}) of T", "N")
+                for hz in RESONANCE_HZ
+                for route in ("tension", "F")
+            ]
+        if kind == "drift":  # per recording and gauge
+            return [
+                Term(kind, route, f"{tr.name}: P{o}(t)", unit)
+                for tr in self.traces
+                for o in DRIFT_ORDERS
+                for route, unit in (("u", "m"), ("F", "N"))
+            ]
+        raise ValueError(f"unknown signature kind {kind!r}")
+
+    def series(self, kind: str, i: int) -> FloatArray:
+        """The kind's terms on trace ``i`` (terms, samples), in ``terms`` order."""
+        tr, out = self.traces[i], self.outputs[i]
+        u, v = tr.segments.u_m, tr.segments.v_m_s
+        rows: list[FloatArray] = []
+        if kind == "position":
+            z = 2 * u / self.u_span - 1
+            rows += [_legendre(z, k) for k in (1, 2, 3)]
+            rows += [_legendre(z, k) for k in (2, 3)]
+            turn = (tr.x_m - tr.x_m[0]) / self.radius
+            rows += [fn(h * turn) for h in (1, 2) for fn in (np.sin, np.cos)]
+        elif kind == "strain":
+            rows += [(np.maximum(out.force_n, 0.0) / self.t_ref) ** p for p in (2, 3)]
+        elif kind == "velocity":
+            rows += [v / self.v_top, v * np.abs(v) / self.v_top**2]
+            rows += [np.tanh(v / s) for s in VELOCITY_SCALES_M_S]
+        elif kind == "resonance":
+            for hz in RESONANCE_HZ:
+                mode = _mode_response(out.force_n, hz, tr.rate_hz)
+                rows += [mode, mode]
+        elif kind == "drift":
+            t = np.linspace(-1.0, 1.0, tr.samples)
+            zero = np.zeros(tr.samples)
+            for j in range(len(self.traces)):
+                for o in DRIFT_ORDERS:
+                    poly = _legendre(t, o) if j == i else zero
+                    rows += [poly, poly]
+        matrix = np.asarray(rows, dtype=np.float64).reshape(-1, tr.samples)
+        return np.where(np.isfinite(matrix), matrix, 0.0)
+
+
+def _legendre(z: FloatArray, order: int) -> FloatArray:
+    coef = np.zeros(order + 1)
+    coef[order] = 1.0
+    return np.asarray(np.polynomial.legendre.legval(z, coef))
+
+
+@lru_cache(maxsize=64)
+def _mode_filter(hz: float, rate_hz: float) -> Filter:
+    w = 2 * np.pi * hz
+    b, a, _ = cont2discrete(([w * w], [1.0, 2 * RESONANCE_ZETA * w, w * w]), 1.0 / rate_hz,
+                            method="bilinear")  # fmt: skip
+    return np.ravel(b), np.ravel(a)
+
+
+def _mode_response(force: FloatArray, hz: float, rate_hz: float) -> FloatArray:
+    """The dynamic part of the tension through a damped mode (zero while it is steady)."""
+    b, a = _mode_filter(hz, rate_hz)
+    base = force - force[0]
+    return np.asarray(lfilter(b, a, base) - base)
+
+
+def _responses(
+    library: _Library,
+    kind: str,
+    terms: Sequence[Term],
+    filters: Sequence[dict[str, tuple[Filter, Filter]]],
+) -> list[tuple[FloatArray, FloatArray]]:
+    """Per trace: every term's predicted (δu, δF), each (terms, samples)."""
+    out = []
+    routes = np.array([t.route for t in terms])
+    for i, tr in enumerate(library.traces):
+        series = library.series(kind, i)
+        du = np.where((routes == "u")[:, None], series, 0.0)
+        df = np.where((routes == "F")[:, None], series, 0.0)
+        taut = library.outputs[i].force_n > 0.0
+        for route in ("weight", "tension"):
+            rows = routes == route
+            if rows.any():
+                fu, ff = filters[i][route]
+                du[rows] = _through_runs(tr, series[rows], fu)
+                df[rows] = _through_runs(tr, series[rows], ff) * taut
+        out.append((du, df))
+    return out
+
+
+def _stack(
+    traces: Sequence[Trace], parts: Sequence[tuple[FloatArray, FloatArray]], which: str
+) -> FloatArray:
+    """(u, F) of every trace at its training or held-out samples, over noise (last axis)."""
+    chunks = []
+    for tr, (u, f) in zip(traces, parts, strict=True):
+        idx = tr.present & (tr.train if which == "train" else ~tr.train)
+        test = tr.test
+        chunks.append(u[..., idx] / _noise_scale(tr.u_m[test], tr.noise_u_m))
+        chunks.append(f[..., idx] / _noise_scale(tr.force_n[test], tr.noise_force_n))
+    return np.concatenate(chunks, axis=-1)
+
+
+def stlsq(design: FloatArray, target: FloatArray, threshold: float) -> FloatArray:
+    """Sequentially thresholded least squares (SINDy's STLSQ) on scaled columns.
+
+    Columns are scaled to unit rms over the samples they touch (a drift term touches one
+    recording's gauge), so ``threshold`` is the least rms (in the target's units) a kept
+    term moves the outputs it acts on.
+    """
+    if design.shape[1] == 0:
+        return np.zeros(0)
+    touched = np.maximum(np.count_nonzero(design, axis=0), 1)
+    norms = np.sqrt(np.sum(design**2, axis=0) / touched)
+    norms = np.where(norms > 0, norms, 1.0)
+    a = design / norms
+    gram = a.T @ a
+    ridge = RIDGE * float(np.max(np.diag(gram))) * np.eye(a.shape[1])
+    keep = np.ones(a.shape[1], dtype=bool)
+    coef = np.zeros(a.shape[1])
+    for _ in range(STLSQ_ROUNDS):
+        coef[:] = 0.0
+        if not keep.any():
+            break
+        sub = np.ix_(keep, keep)
+        coef[keep] = np.linalg.solve(gram[sub] + ridge[sub], a[:, keep].T @ target)
+        small = np.abs(coef) < threshold
+        if not np.any(small & keep):
+            break
+        keep &= ~small
+    coef[~keep] = 0.0
+    return coef / norms
+
+
+def _cycle_average(traces: Sequence[Trace], outputs: Sequence[Outputs]) -> list[Outputs]:
+    """Each held-out cycle's remainder predicted by the training cycles' mean at its offset."""
+    predicted = []
+    for tr, out in zip(traces, outputs, strict=True):
+        pu, pf = np.zeros(tr.samples), np.zeros(tr.samples)
+        ru = np.where(tr.present, tr.u_m - out.u_m, np.nan)
+        rf = np.where(tr.present, tr.force_n - out.force_n, np.nan)
+        cycles = [c for c in np.unique(tr.cycle) if c >= 0]
+        starts = {c: int(np.flatnonzero(tr.cycle == c)[0]) for c in cycles}
+        trained = [c for c in cycles if np.all(tr.train[tr.cycle == c])]
+        for c in cycles:
+            if c in trained or not trained:
+                continue
+            mine = np.flatnonzero(tr.cycle == c)
+            offsets = mine - starts[c]
+            stack_u, stack_f = [], []
+            for t in trained:
+                at = starts[t] + offsets
+                ok = at < tr.samples
+                su, sf = np.full(mine.size, np.nan), np.full(mine.size, np.nan)
+                su[ok], sf[ok] = ru[at[ok]], rf[at[ok]]
+                stack_u.append(su)
+                stack_f.append(sf)
+            with np.errstate(all="ignore"):
+                pu[mine] = np.nan_to_num(np.nanmean(np.stack(stack_u), axis=0))
+                pf[mine] = np.nan_to_num(np.nanmean(np.stack(stack_f), axis=0))
+        predicted.append(Outputs(pu, pf))
+    return predicted
+
+
+def _channel(energy: dict[str, float]) -> str:
+    """Where a fit's predicted remainder lies: one gauge (a sensor) or both (physical).
+
+    ``energy``: its squared predicted remainder in noise units by route group (``u``,
+    ``F``: one gauge's reading; ``physical``: through the stand's dynamics). The group
+    with most of it names the channel.
+    """
+    top = max(energy, key=energy.__getitem__)
+    return "u+F" if top == "physical" or energy[top] <= 0 else top
+
+
+def fit_signatures(
+    traces: Sequence[Trace],
+    outputs: Sequence[Outputs],
+    nominal: StandParams,
+    values: dict[str, float],
+) -> list[SignatureFit]:
+    """Every kind fitted to the remainder of ``outputs`` on the training cycles.
+
+    ``values``: the fitted baseline scales (the taut dynamics the terms pass through).
+    Each fit's ``outputs`` are the model's plus the kind's predicted remainder, to be
+    judged on the held-out cycles like any candidate.
+    """
+    filters = [_taut_filters(tr.mass_kg, nominal, values, tr.rate_hz) for tr in traces]
+    residual = [
+        (
+            np.where(tr.present, tr.u_m - o.u_m, 0.0),
+            np.where(tr.present, tr.force_n - o.force_n, 0.0),
+        )
+        for tr, o in zip(traces, outputs, strict=True)
+    ]
+    target = _stack(traces, residual, "train")
+    library = _Library(traces, outputs, nominal)
+    fits = []
+    for kind in KINDS[:-1]:
+        mine = library.terms(kind)
+        responses = _responses(library, kind, mine, filters)
+        design = _stack(traces, responses, "train").T
+        coef = stlsq(design, target, THRESHOLD_NOISE)
+        used = np.flatnonzero(coef)
+        predicted = [Outputs(coef[used] @ du[used], coef[used] @ df[used]) for du, df in responses]
+        formula = " + ".join(_term_text(mine[j], coef[j]) for j in used) or "0"
+        channel = _channel(_energy(traces, [mine[j] for j in used], coef[used], responses, used))
+        fits.append(SignatureFit(kind, _added(outputs, predicted), channel, formula, predicted))
+    averaged = _cycle_average(traces, outputs)
+    fits.append(
+        SignatureFit(
+            "other", _added(outputs, averaged), "u+F",
+            "repeats with the motion (training cycles' mean at the same drive phase)", averaged,
+        )
+    )  # fmt: skip
+    return fits
+
+
+def _energy(
+    traces: Sequence[Trace],
+    terms: Sequence[Term],
+    coef: FloatArray,
+    responses: Sequence[tuple[FloatArray, FloatArray]],
+    used: NDArray[np.intp],
+) -> dict[str, float]:
+    """Squared predicted remainder (noise units) of the used terms, by route group."""
+    energy = {"u": 0.0, "F": 0.0, "physical": 0.0}
+    for term, w, j in zip(terms, coef, used, strict=True):
+        group = term.route if term.route in ("u", "F") else "physical"
+        parts = [(du[j : j + 1], df[j : j + 1]) for du, df in responses]
+        energy[group] += float(np.sum((w * _stack(traces, parts, "train")) ** 2))
+    return energy
+
+
+def _added(outputs: Sequence[Outputs], predicted: Sequence[Outputs]) -> list[Outputs]:
+    return [
+        Outputs(o.u_m + p.u_m, o.force_n + p.force_n)
+        for o, p in zip(outputs, predicted, strict=True)
+    ]
+
+
+_WHERE = {"weight": "force on the weight", "tension": "fibre tension", "u": "u reading",
+          "F": "F reading"}  # fmt: skip
+
+
+def _term_text(term: Term, weight: float) -> str:
+    unit = "mm" if term.unit == "m" else term.unit
+    value = weight * 1e3 if term.unit == "m" else weight
+    return f"{value:+.3g} {unit}·{term.name} [{_WHERE[term.route]}]"
