@@ -31,7 +31,7 @@ if TYPE_CHECKING:  # imported where they run: `diagnose-check --help` loads no n
 
 # Literal copies of sim.identify.check's TRUTHS and MASSES_KG, which imports numba: the
 # parser is built without it (tests/core/test_cli_startup.py checks that they agree).
-TRUTHS = ("same", "other")
+TRUTHS = ("same", "other", "outside")
 #: The check's recording sets (``sim.identify.check.RECORDING_SETS``, not imported here:
 #: ``--help`` loads no numba).
 RECORDING_SETS = ("moderate", "gentle", "brisk", "paper")
@@ -56,9 +56,17 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
         "--truth",
         choices=TRUTHS,
         default="same",
-        help="where the truth comes from: 'same' (the candidate models' own code, default) "
-        "or 'other' (an independently written stand with a second form of every effect, "
-        "other drive signals and the validation set's noise)",
+        help="where the truth comes from: 'same' (the candidate models' own code, default), "
+        "'other' (an independently written stand with a second form of every effect, "
+        "other drive signals and the validation set's noise) or 'outside' (that stand with "
+        "five effects outside the catalogue, none, and none with recorder artefacts)",
+    )
+    parser.add_argument(
+        "--triples",
+        nargs="*",
+        metavar="A+B+C",
+        help="with --truth other: also campaigns with three effects at once (no value: the "
+        "standard triples; else the given ones)",
     )
     parser.add_argument(
         "--pairs",
@@ -146,42 +154,52 @@ def run_cases(
         return run_jobs(client, job, specs, keys, progress, threads, tell)
 
 
-def _classes(args: argparse.Namespace) -> list[str] | None:
-    """The classes asked for (None: all; CommandError, exit 2, for an unknown one)."""
-    from sim.identify.check import CLASSES
+def _classes(args: argparse.Namespace) -> list[str]:
+    """The classes asked for (CommandError, exit 2, for an unknown one)."""
+    from sim.identify.check import ARTEFACTS, CLASSES, OUTSIDE_CLASSES
 
+    known = OUTSIDE_CLASSES if args.truth == "outside" else [*CLASSES, ARTEFACTS]
     if args.effects is None:
-        return None
-    unknown = [name for name in args.effects if name not in CLASSES]
+        return list(OUTSIDE_CLASSES if args.truth == "outside" else CLASSES)
+    unknown = [name for name in args.effects if name not in known]
     if unknown:
         raise CommandError(
-            f"--effects: unknown class {unknown[0]!r} (known: {', '.join(CLASSES)})",
+            f"--effects: unknown class {unknown[0]!r} (known: {', '.join(known)})",
             ExitCode.USAGE,
         )
     return list(args.effects)
 
 
-def _pairs(args: argparse.Namespace) -> list[tuple[str, str]]:
-    """The two-effect campaigns asked for (CommandError, exit 2, if malformed)."""
-    from sim.otherstand import OTHER_EFFECTS, OTHER_PAIRS
+def _pairs(args: argparse.Namespace) -> list[tuple[str, ...]]:
+    """The two- and three-effect campaigns asked for (CommandError, exit 2, if malformed)."""
+    from sim.otherstand import OTHER_EFFECTS, OTHER_PAIRS, OTHER_TRIPLES
 
-    if args.pairs is None:
-        return []
-    if args.truth != "other":
-        raise CommandError("--pairs needs --truth other", ExitCode.USAGE)
-    if not args.pairs:
-        return list(OTHER_PAIRS)
-    pairs = []
-    for text in args.pairs:
-        names = text.split("+")
-        if len(names) != 2 or names[0] == names[1] or not set(names) <= set(OTHER_EFFECTS):
-            raise CommandError(
-                f"--pairs: {text!r} is not two different effects joined by '+' "
-                f"(known: {', '.join(OTHER_EFFECTS)})",
-                ExitCode.USAGE,
-            )
-        pairs.append((names[0], names[1]))
-    return pairs
+    chosen: list[tuple[str, ...]] = []
+    for flag, given, size, standard in (
+        ("--pairs", args.pairs, 2, OTHER_PAIRS),
+        ("--triples", args.triples, 3, OTHER_TRIPLES),
+    ):
+        if given is None:
+            continue
+        if args.truth != "other":
+            raise CommandError(f"{flag} needs --truth other", ExitCode.USAGE)
+        if not given:
+            chosen += list(standard)
+            continue
+        for text in given:
+            names = tuple(text.split("+"))
+            if (
+                len(names) != size
+                or len(set(names)) != size
+                or not set(names) <= set(OTHER_EFFECTS)
+            ):
+                raise CommandError(
+                    f"{flag}: {text!r} is not {size} different effects joined by '+' "
+                    f"(known: {', '.join(OTHER_EFFECTS)})",
+                    ExitCode.USAGE,
+                )
+            chosen.append(names)
+    return chosen
 
 
 def _recording_set(args: argparse.Namespace) -> str:
@@ -210,9 +228,7 @@ def run(args: argparse.Namespace) -> int:
     else:
         chosen = recording_set(recordings, stand)
         setup = CheckSetup(stand, chosen, args.truth, chosen)
-    specs = check_cases(
-        args.seed, args.trials, CLASSES if classes is None else classes, args.mass_kg, pairs
-    )
+    specs = check_cases(args.seed, args.trials, classes, args.mass_kg, pairs)
     progress = Progress(LABEL, len(specs), quiet=args.json)
     results = run_cases(setup, specs, options, progress)
     result = score(r.value[0] for r in results if r.value is not None)
@@ -235,7 +251,7 @@ def run(args: argparse.Namespace) -> int:
             )
             for spec, r in zip(specs, results, strict=True)
         ]
-        files = write_results(args.results, rows, CLASSES)
+        files = write_results(args.results, rows, list(dict.fromkeys([*CLASSES, *classes])))
         progress.say(f"wrote {', '.join(str(f) for f in files)}")
     code = _report(args, out)
     return ExitCode.FAILURE if say_failures(LABEL, results) else code
@@ -273,7 +289,23 @@ def _report(args: argparse.Namespace, out: dict[str, Any]) -> int:
         p = out["pairs"]
         both = f"{p['both_named']:.2f}" if p["effects_reported"] else "n/a (no effects list yet)"
         print(
-            f"{p['cases']} two-effect campaigns: both named {both}, "
-            f"strongest answer one of the pair {p['one_named']:.2f}"
+            f"{p['cases']} several-effect campaigns: pairs both named {both}, "
+            f"strongest answer one of the truth {p['one_named']:.2f}"
         )
+        if "triples" in p:
+            print(
+                f"  {p['triples']} triples: all three named {p['all_three_named']:.2f}, "
+                f"at least two {p['at_least_two_named']:.2f}"
+            )
+    words = {
+        "none_adequate": "none (and artefact-only) answered baseline_adequate",
+        "outside_flagged": "outside truths answered unexplained or partly_explained",
+        "outside_catalogue_named": "outside truths with a catalogue effect named",
+        "outside_kind_right": "outside truths whose best signature is of the right kind",
+        "catalogue_exact": "single-effect truths named exactly (no extra effect)",
+    }
+    for key, text in words.items():
+        value = out.get("verdicts", {}).get(key)
+        if value is not None:
+            print(f"{text}: {value:.2f}")
     return 0

@@ -43,13 +43,19 @@ from sim.identify.shooting import dial_slope
 from sim.identify.traces import Trace, make_trace
 from sim.model import Model
 from sim.otherstand.campaign import OTHER_FULL, OTHER_SETS, OtherRecording
+from sim.otherstand.outside import OUTSIDE_EFFECTS, SIGNATURE_KIND
 from sim.params import StandParams
 
 log = logging.getLogger(__name__)
 
 CLASSES = ["none", *EFFECTS]
-#: Where a check's truth comes from: the candidates' own code, or the other stand.
-TRUTHS = ("same", "other")
+#: Where a check's truth comes from: the candidates' own code, the other stand, or the
+#: other stand with effects outside the catalogue (``sim.otherstand.outside``).
+TRUTHS = ("same", "other", "outside")
+#: A ``none`` campaign whose recorder adds artefacts (``Realism.with_artefacts``).
+ARTEFACTS = "artefacts"
+#: The outside truth's classes: none, none with artefacts, and the five outside effects.
+OUTSIDE_CLASSES = ["none", ARTEFACTS, *OUTSIDE_EFFECTS]
 MASSES_KG = (3.096, 8.131)
 #: Drive encoder noise on x, m rms (the model is driven by the *measured* x).
 DRIVE_NOISE_M = 1e-6
@@ -103,6 +109,11 @@ class Case:
     #: decision's test, as a single test); None where it cannot be judged alike (the
     #: other stand's truth is open loop). False: ``none`` is a right answer too.
     identifiable: bool | None = None
+    #: The diagnosis's verdict, every effect it named, and the kinds of the signatures
+    #: that describe its remainder (best first).
+    verdict: str = ""
+    named: tuple[str, ...] = ()
+    signature_kinds: tuple[str, ...] = ()
 
     @property
     def right(self) -> bool:
@@ -118,14 +129,15 @@ class CheckResult:
     pair_cases: list[PairCase] = field(default_factory=list)
 
     def to_dict(self) -> dict[str, Any]:
-        """accuracy, false_alarm_rate, confusion, median_shrink, oracle_median_shrink, ..."""
-        labels = CLASSES
-        confusion = {t: dict.fromkeys(labels, 0) for t in labels}
+        """accuracy, false_alarm_rate, confusion, median_shrink, verdicts, details, ..."""
+        truths = list(dict.fromkeys(c.truth for c in self.cases))
+        labels = list(dict.fromkeys([*CLASSES, *truths]))
+        confusion = {t: dict.fromkeys(labels, 0) for t in truths}
         for c in self.cases:
             confusion[c.truth][c.answer] += 1
         n = len(self.cases)
         correct = [c for c in self.cases if c.answer == c.truth]
-        nones = [c for c in self.cases if c.truth == "none"]
+        nones = [c for c in self.cases if c.truth in ("none", ARTEFACTS)]
         effects_ok = [c for c in correct if c.truth != "none"]
         return {
             "cases": n,
@@ -144,9 +156,39 @@ class CheckResult:
                 float(np.median([c.oracle_shrink for c in effects_ok])) if effects_ok else 0.0
             ),
             "median_seconds": float(np.median([c.seconds for c in self.cases])) if n else 0.0,
+            "verdicts": verdict_summary(self.cases),
             "details": [c.__dict__ for c in self.cases],
             **({"pairs": pairs_summary(self.pair_cases)} if self.pair_cases else {}),
         }
+
+
+def verdict_summary(cases: Sequence[Case]) -> dict[str, Any]:
+    """What the verdicts say, by kind of truth (each share over its campaigns; None: none).
+
+    ``none``: none and artefact-only campaigns answered ``baseline_adequate``;
+    ``outside``: out-of-catalogue truths answered ``unexplained`` or
+    ``partly_explained``, with a catalogue effect named, with the best signature of the
+    truth's kind; ``catalogue``: single-effect truths whose named set is exactly the truth.
+    """
+
+    def share(selected: Sequence[Case], test: Callable[[Case], bool]) -> float | None:
+        return sum(map(test, selected)) / len(selected) if selected else None
+
+    nones = [c for c in cases if c.truth in ("none", ARTEFACTS)]
+    outside = [c for c in cases if c.truth in OUTSIDE_EFFECTS]
+    catalogue = [c for c in cases if c.truth in EFFECTS]
+    return {
+        "none_adequate": share(nones, lambda c: c.verdict == "baseline_adequate"),
+        "outside_flagged": share(
+            outside, lambda c: c.verdict in ("unexplained", "partly_explained")
+        ),
+        "outside_catalogue_named": share(outside, lambda c: bool(c.named)),
+        "outside_kind_right": share(
+            outside,
+            lambda c: bool(c.signature_kinds) and c.signature_kinds[0] == SIGNATURE_KIND[c.truth],
+        ),
+        "catalogue_exact": share(catalogue, lambda c: c.named == (c.truth,)),
+    }
 
 
 def make_campaign(
@@ -169,9 +211,11 @@ def make_campaign(
     ``effect.param``, and the oracle is the other stand's noise-free channels (its
     equations are not the candidates', so no candidate can be judged as the truth).
     """
-    if truth_stand == "other":
-        names = [] if truth == "none" else truth.split("+")
-        return other_campaign_traces(stand, names, mass_kg, rng, other_campaign)
+    if truth_stand in ("other", "outside"):
+        names = [] if truth in ("none", ARTEFACTS) else truth.split("+")
+        return other_campaign_traces(
+            stand, names, mass_kg, rng, other_campaign, artefacts=truth == ARTEFACTS
+        )
     if truth_stand != "same":
         raise ValueError(f"truth_stand must be one of {', '.join(TRUTHS)}, got {truth_stand!r}")
     nominal = stand.stand_params("final", mass_kg)
@@ -266,7 +310,7 @@ def check_cases(
     trials: int = 1,
     classes: Sequence[str] = CLASSES,
     masses: Sequence[float] = MASSES_KG,
-    pairs: Sequence[tuple[str, str]] = (),
+    pairs: Sequence[tuple[str, ...]] = (),
 ) -> list[CaseSpec]:
     """The campaigns of a check: trials × masses × (classes, then pairs)."""
     return [
@@ -288,8 +332,8 @@ def diagnose_case(
 
     Returns the scored case (a ``PairCase`` for two effects) and the full diagnosis.
     """
-    if spec.pair and truth_stand != "other":
-        raise ValueError("two-effect campaigns need the other truth stand")
+    if spec.pair and truth_stand == "same":
+        raise ValueError("several effects at once need the other truth stand")
     traces, oracle, params = make_campaign(
         stand, spec.truth, spec.mass_kg, spec.rng(), campaign,
         truth_stand=truth_stand, other_campaign=other_campaign,
@@ -298,8 +342,8 @@ def diagnose_case(
     d = diagnose(traces, stand.stand_params("final", spec.mass_kg))
     seconds = time.perf_counter() - started
     if spec.pair:
-        a, b = spec.truth.split("+")
-        return PairCase((a, b), spec.mass_kg, d.effect, named_effects(d), params, seconds), d
+        truth = tuple(spec.truth.split("+"))
+        return PairCase(truth, spec.mass_kg, d.effect, named_effects(d), params, seconds), d
     e_before = d.heldout_error_before
     shrink = (e_before - d.heldout_error_after) / e_before if e_before > 0 else 0.0
     e_true = heldout_error(traces, oracle)
@@ -309,9 +353,11 @@ def diagnose_case(
         # The truth judged like a candidate against the fitted baseline: if even it is
         # no evidence of an effect, ``none`` is what the recordings show.
         identifiable = compare(traces, d.outputs_before, oracle).accepted(tests=1)
+    kinds = tuple(s.kind for s in d.remainder.signature if s.passes) if d.remainder else ()
     case = Case(
-        spec.truth, spec.mass_kg, d.effect, params, shrink, oracle_shrink, seconds, identifiable
-    )
+        spec.truth, spec.mass_kg, d.effect, params, shrink, oracle_shrink, seconds, identifiable,
+        d.verdict, named_effects(d), kinds,
+    )  # fmt: skip
     return case, d
 
 
@@ -324,9 +370,12 @@ def describe(case: Case | PairCase) -> str:
             f"(effects {case.answers}; {mark}, {case.seconds:.0f} s)"
         )
     mark = "ok" if case.answer == case.truth else "WRONG"
+    if case.truth in OUTSIDE_EFFECTS or case.truth == ARTEFACTS:
+        mark = "outside" if case.truth in OUTSIDE_EFFECTS else "artefacts"
+    kinds = f", signature {'/'.join(case.signature_kinds)}" if case.signature_kinds else ""
     return (
-        f"m={case.mass_kg:g} kg truth {case.truth}: answer {case.answer} ({mark}, "
-        f"{case.seconds:.0f} s)"
+        f"m={case.mass_kg:g} kg truth {case.truth}: answer {case.answer}, {case.verdict}"
+        f"{kinds} ({mark}, {case.seconds:.0f} s)"
     )
 
 
@@ -351,7 +400,7 @@ def run_check(
     progress: Callable[[str], None] | None = None,
     truth_stand: str = "same",
     other_campaign: Sequence[OtherRecording] = OTHER_FULL,
-    pairs: Sequence[tuple[str, str]] = (),
+    pairs: Sequence[tuple[str, ...]] = (),
 ) -> CheckResult:
     """Diagnose trials × classes × masses blind campaigns one after another and score them.
 
@@ -360,8 +409,8 @@ def run_check(
     The same campaigns run in parallel elsewhere (``labstand.distributed``) through
     ``check_cases``, ``diagnose_case`` and ``score``.
     """
-    if pairs and truth_stand != "other":
-        raise ValueError("two-effect campaigns need the other truth stand")
+    if pairs and truth_stand == "same":
+        raise ValueError("several effects at once need the other truth stand")
     say = progress or (lambda _m: None)
     specs = check_cases(seed, trials, classes, masses, pairs)
     cases: list[Case | PairCase] = []

@@ -16,15 +16,16 @@ from sim.identify.heldout import Outputs
 from sim.identify.report import Diagnosis
 from sim.identify.traces import Trace, make_trace
 from sim.otherstand.campaign import OtherRecording, make_other_campaign
+from sim.otherstand.gauges import Realism
 
 __all__ = ["PairCase", "named_effects", "other_campaign_traces", "pairs_summary"]
 
 
 @dataclass(frozen=True)
 class PairCase:
-    """One blind diagnosis of a campaign with two effects at once."""
+    """One blind diagnosis of a campaign with two (or three) effects at once."""
 
-    truth: tuple[str, str]
+    truth: tuple[str, ...]
     mass_kg: float
     answer: str
     #: The diagnosis's accepted effects, or None while it reports only one.
@@ -36,6 +37,11 @@ class PairCase:
     def both_named(self) -> bool:
         """Both true effects among the accepted ones (False without an ``effects`` list)."""
         return self.answers is not None and set(self.truth) <= set(self.answers)
+
+    @property
+    def named_count(self) -> int:
+        """How many of the true effects are among the accepted ones."""
+        return len(set(self.truth) & set(self.answers or ()))
 
     @property
     def one_named(self) -> bool:
@@ -51,9 +57,20 @@ def pairs_summary(cases: Sequence[PairCase]) -> dict[str, Any]:
     the pair) counts.
     """
     n = len(cases)
+    triples = [c for c in cases if len(c.truth) == 3]
+    pairs = [c for c in cases if len(c.truth) == 2]
     return {
         "cases": n,
-        "both_named": sum(c.both_named for c in cases) / n if n else 0.0,
+        "both_named": sum(c.both_named for c in pairs) / len(pairs) if pairs else 0.0,
+        **(
+            {
+                "triples": len(triples),
+                "all_three_named": sum(c.both_named for c in triples) / len(triples),
+                "at_least_two_named": sum(c.named_count >= 2 for c in triples) / len(triples),
+            }
+            if triples
+            else {}
+        ),
         "one_named": sum(c.one_named for c in cases) / n if n else 0.0,
         "effects_reported": all(c.answers is not None for c in cases),
         "details": [
@@ -68,13 +85,19 @@ def other_campaign_traces(
     mass_kg: float,
     rng: np.random.Generator,
     recordings: Sequence[OtherRecording],
+    artefacts: bool = False,
 ) -> tuple[list[Trace], list[Outputs], dict[str, float]]:
     """Traces, noise-free outputs and parameters (``effect.param``) of a campaign.
 
-    The campaign runs on the other stand with the named effects (none, one or two).
+    The campaign runs on the other stand with the named effects (none, or several; the
+    out-of-catalogue ones too); ``artefacts``: its recorder adds drawn artefacts (lost
+    samples, jitter, a hum harmonic, spikes: ``Realism.with_artefacts``).
     """
     nominal = stand.stand_params("final", mass_kg)
-    camp = make_other_campaign(nominal, effects, rng, recordings, stand.sample_rate_hz)
+    realism = Realism.with_artefacts(rng) if artefacts else None
+    camp = make_other_campaign(
+        nominal, effects, rng, recordings, stand.sample_rate_hz, realism=realism
+    )
     traces = [make_trace(name, t, x, u, f, mass_kg) for name, t, x, u, f in camp.recordings]
     oracle = [Outputs(u, f) for u, f in zip(camp.truth_u, camp.truth_f, strict=True)]
     params = {f"{e}.{k}": v for e, values in camp.effects.items() for k, v in values.items()}

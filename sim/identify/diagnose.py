@@ -389,25 +389,22 @@ def signature_rival(
     values: dict[str, float],
     effect: Sequence[Outputs],
 ) -> str | None:
-    """The kind of library term that does at least as well as an effect, or None.
+    """The kind of library term that predicts better than an effect, or None.
 
     A catalogue effect that fits a gap of another kind closes part of it (a gauge's gain
-    soaks up a drifting force offset): it is named only if no signature of the remainder
-    (``signature``) that is itself evidence does as well. The effect stands if it beats
-    the best such signature on the held-out cycles (``beats``), or if neither beats the
-    other and the effect's held-out error is the lower.
+    soaks up a drifting force offset): it is not named if a signature of the remainder
+    (``signature``) that is itself evidence beats it on the held-out cycles (``beats``).
+    Where neither beats the other the effect stands: it has a handful of physical
+    parameters against the library's dozen free terms, which over two short recordings
+    fitted a Maxwell branch with a gauge's gain as well as the branch did (X 23.8 against
+    24.4) with a 100 N pulley eccentricity.
     """
     signatures, fits, _ = judge_signatures(traces, before, nominal, values)
     passing = [s for s in signatures if s.passes]
     if not passing:
         return None
     best = passing[0]  # the lowest held-out error among those that pass
-    rival = fits[best.kind].outputs
-    if beats(traces, effect, rival):
-        return None
-    if not beats(traces, rival, effect) and heldout_excess(traces, effect) <= best.excess_after:
-        return None
-    return best.kind
+    return best.kind if beats(traces, fits[best.kind].outputs, effect) else None
 
 
 def strongest_accepted(

@@ -8,7 +8,8 @@ damping term c·δ̇ at re-tensioning costs no order of accuracy. Stick/slip swi
 Karnopp friction laws are left to the fine step (their band keeps them continuous enough).
 
 State vector (``N_STATE``): u, v (weight), s, w (pulley rim), q (Maxwell branches, two per
-fibre segment), p (seat length change), a and ȧ (three string modes of each free span).
+fibre segment), p (seat length change), a and ȧ (three string modes of each free span),
+z and ż (the drive anchor, for the out-of-catalogue terms).
 Parameter row: the ``P_*`` indices below, filled by ``sim.otherstand.stand``.
 """
 
@@ -24,7 +25,11 @@ from numba import njit
  P_MU, P_VE_ON, P_KA, P_TAUA, P_KB, P_TAUB, P_TV_ON, P_ETA, P_DRAG, P_GP1, P_GP2, P_EXC,
  P_PJ_ON, P_STEP, P_THR, P_TAUS, P_SEATS, P_SHARE, P_PI_ON, P_MP, P_FK, P_FS, P_CV,
  P_SS_ON, P_RATIO, P_VS, P_EXP, P_SL_ON, P_MUW, P_SINB, P_PEXP, P_TSTICK, P_VBAND,
- N_PARAM) = range(48)  # fmt: skip
+ P_HARD, P_WAVE_A, P_WAVE_K, P_WAVE_PH, P_VISC, P_QDRAG, P_FR_ON, P_FR_W, P_FR_Z, P_FR_M,
+ N_PARAM) = range(58)  # fmt: skip
+# P_HARD … P_FR_M: the out-of-catalogue terms (``sim.otherstand.outside``): the fibre's
+# strain stiffening, a force along a wavy guide, viscous and quadratic drag on the
+# weight, and a compliant drive anchor (a mode of its own, frequency, damping, mass).
 
 # State indices.
 S_U, S_V, S_S, S_W, S_Q, S_P, S_A = 0, 1, 2, 3, 4, 8, 9
@@ -32,7 +37,9 @@ N_MODES = 3
 #: Reference tension of the side load's nonlinearity, N (see the effect's docstring).
 SIDE_REF_N = 50.0
 S_AD = S_A + 2 * N_MODES
-N_STATE = S_AD + 2 * N_MODES
+#: The drive anchor's displacement towards the pulley and its rate (``P_FR_ON``).
+S_Z = S_AD + 2 * N_MODES
+N_STATE = S_Z + 2
 
 
 @njit(cache=True)
@@ -78,6 +85,9 @@ def elongations(y, x, xd, p, arest, target, out):  # type: ignore[no-untyped-def
     if p[P_TV_ON] > 0:
         s0, sd0 = _stretch(y, p, arest, 0)
         s1, sd1 = _stretch(y, p, arest, 1)
+    # A compliant anchor takes its displacement off the drive's end of the fibre.
+    x = x - y[S_Z]
+    xd = xd - y[S_Z + 1]
     if p[P_PI_ON] > 0:
         k1 = p[P_K] * p[P_LTOT] / p[P_SEG1]
         k2 = p[P_K] * p[P_LTOT] / p[P_SEG2]
@@ -115,7 +125,8 @@ def rhs(y, x, xd, p, tab_x, tab_c, arest, taut, target, dy, tens):  # type: igno
         t = 0.0
         qa = S_Q + 2 * seg
         if taut[seg]:
-            t = scale * (p[P_K] * d + p[P_C] * dd) + y[qa] + y[qa + 1]
+            elastic = p[P_K] * d * (1.0 + p[P_HARD] * p[P_K] * d / SIDE_REF_N)
+            t = scale * (elastic + p[P_C] * dd) + y[qa] + y[qa + 1]
             t = max(t, 0.0)
         if p[P_VE_ON] > 0:
             rate = dd if taut[seg] else 0.0
@@ -153,8 +164,21 @@ def rhs(y, x, xd, p, tab_x, tab_c, arest, taut, target, dy, tens):  # type: igno
         else:
             fr = (p[P_NORMAL] * _mu(vreg, tab_x, tab_c) + side) * v / vreg
         acc = (applied - fr) / m
+    if p[P_WAVE_A] != 0.0:
+        acc += p[P_WAVE_A] * math.sin(p[P_WAVE_K] * y[S_U] + p[P_WAVE_PH]) / m
+    acc -= (p[P_VISC] * v + p[P_QDRAG] * v * abs(v)) / m
     dy[S_U] = v
     dy[S_V] = acc
+    # The drive anchor: pulled towards the pulley by the tension beyond the preload.
+    if p[P_FR_ON] > 0:
+        w = p[P_FR_W]
+        z = y[S_Z]
+        zd = y[S_Z + 1]
+        dy[S_Z] = zd
+        dy[S_Z + 1] = (tens[0] - p[P_T0]) / p[P_FR_M] - w * w * z - 2.0 * p[P_FR_Z] * w * zd
+    else:
+        dy[S_Z] = 0.0
+        dy[S_Z + 1] = 0.0
     # The pulley (rim coordinates).
     if p[P_PI_ON] > 0:
         w = y[S_W]

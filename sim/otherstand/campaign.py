@@ -18,8 +18,8 @@ from numpy.typing import NDArray
 
 from drivers.limits import DriveLimits
 from drivers.signals import Shape, SignalSpec, plan_motion
-from sim.otherstand.effects import OTHER_EFFECTS
 from sim.otherstand.gauges import Realism
+from sim.otherstand.outside import ALL_EFFECTS
 from sim.otherstand.stand import simulate
 from sim.params import StandParams
 
@@ -141,7 +141,7 @@ def make_other_campaign(
     chosen: dict[str, dict[str, float]] = {}
     for name in effects:
         given = (params or {}).get(name)
-        chosen[name] = dict(given) if given is not None else OTHER_EFFECTS[name].draw(rng)
+        chosen[name] = dict(given) if given is not None else ALL_EFFECTS[name].draw(rng)
     noise = realism or Realism()
     out: list[tuple[str, FloatArray, FloatArray, FloatArray, FloatArray]] = []
     truth_u, truth_f = [], []

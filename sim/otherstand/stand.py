@@ -3,7 +3,8 @@
 ``simulate(stand, effects, x_m, rate_hz)`` runs the physics (``_kernel``) at a fine
 rate and passes it through the gauges (``gauges.record``). ``stand`` is a
 ``sim.params.StandParams`` (geometry, the true k, c, friction); ``effects`` maps effect
-names of ``OTHER_EFFECTS`` to their parameters (missing ones take the off values).
+names of ``OTHER_EFFECTS`` (or ``outside.OUTSIDE_EFFECTS``) to their parameters
+(missing ones take the off values).
 Several effects compose: each acts on its own part of the stand.
 """
 
@@ -17,8 +18,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sim.otherstand import _kernel as kern
-from sim.otherstand.effects import OTHER_EFFECTS, check_effects
 from sim.otherstand.gauges import record
+from sim.otherstand.outside import ALL_EFFECTS, check_effects, fill_outside
 from sim.params import StandParams
 
 FloatArray = NDArray[np.float64]
@@ -130,6 +131,7 @@ def parameter_row(
         v = e["side_load_friction"]
         p[kern.P_SL_ON] = 1.0
         p[kern.P_MUW], p[kern.P_PEXP] = v["wall_mu"], v["exponent"]
+    fill_outside(p, stand, e)
     return p, arest
 
 
@@ -156,7 +158,7 @@ def simulate(
     tab_x, tab_c = _friction_pieces(stand)
     res = kern.simulate_kernel(x - x[0], float(rate_hz), int(oversample), int(substeps), p,
                             tab_x, tab_c, arest)  # fmt: skip
-    measured = {k: v for k, v in full.items() if OTHER_EFFECTS[k].kind == "measurement"}
+    measured = {k: v for k, v in full.items() if ALL_EFFECTS[k].kind == "measurement"}
     u_rec, f_rec = record(res[0], res[2], rate_hz, oversample, measured)
     every = slice(None, None, oversample)
     return OtherRun(
