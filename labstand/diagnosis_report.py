@@ -155,6 +155,83 @@ def _overlay_plot(path: Path, traces: Sequence[Trace], result: Diagnosis) -> Non
     plt.close(fig)
 
 
+def _remainder_plot(path: Path, traces: Sequence[Trace], result: Diagnosis) -> bool:
+    """The final model's remainder against what its best signature predicts (False: none).
+
+    Per recording, each channel the signature acts in: the remainder (recorded − model)
+    in grey, the signature's fit in colour, held-out cycles shaded.
+    """
+    rem = result.remainder
+    passing = [s for s in rem.signature if s.passes] if rem is not None else []
+    if rem is None or not passing:
+        return False
+    best = passing[0]
+    fit = rem.fits[f"{best.kind} in {best.channel}"]
+    channels = [c for c in ("u", "F") if c in best.channel]
+    plt = pyplot()
+    fig, axes = plt.subplots(
+        len(traces) * len(channels), 1, figsize=(11, 2.4 * len(traces) * len(channels) + 0.6),
+        squeeze=False, layout="constrained",
+    )  # fmt: skip
+    row = 0
+    for tr, out, pred in zip(traces, result.outputs_after, fit.predicted, strict=True):
+        t = np.arange(tr.samples) / tr.rate_hz
+        for ch in channels:
+            scale, unit = (1e3, "mm") if ch == "u" else (1.0, "N")
+            rec, sim, p = (
+                (tr.u_m, out.u_m, pred.u_m)
+                if ch == "u"
+                else (tr.force_n, out.force_n, pred.force_n)
+            )
+            ax = axes[row, 0]
+            ax.plot(t, np.where(tr.present, rec - sim, np.nan) * scale, color="0.6", lw=0.5,
+                    label="remainder (recorded − model)")  # fmt: skip
+            ax.plot(t, p * scale, color="tab:red", lw=1.0, label=f"{best.kind} term")
+            low, high = ax.get_ylim()
+            ax.fill_between(t, low, high, where=~tr.train, color="k", alpha=0.06,
+                            label="held out")  # fmt: skip
+            ax.set_ylim(low, high)
+            ax.set_ylabel(f"{ch} [{unit}]")
+            ax.set_title(f"{tr.name}", fontsize=10, loc="left")
+            ax.grid(alpha=0.3)
+            row += 1
+    axes[-1, 0].set_xlabel("time [s]")
+    handles, labels = axes[0, 0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="outside upper center", ncol=3, fontsize=10)
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+    return True
+
+
+def _remainder_section(result: Diagnosis, plotted: bool) -> str:
+    """What remains after the named effects: the test, and the signatures that pass."""
+    from sim.identify.remainder import VERDICT_WORDS
+
+    rem = result.remainder
+    if rem is None:
+        return ""
+    state = "beyond the noise" if rem.beyond_noise else "within what the noise allows"
+    rows = "".join(
+        f"<tr><td>{html.escape(s.kind)}</td><td>{html.escape(s.channel)}</td>"
+        f"<td>{s.closes:.0%}</td><td>{s.p_family:.2g}</td><td>{'yes' if s.passes else 'no'}</td>"
+        f"<td><code>{html.escape(s.formula)}</code></td></tr>"
+        for s in rem.signature
+    )
+    plot = (
+        '<img src="remainder.png" alt="the remainder against its best signature">'
+        if plotted
+        else ""
+    )
+    return f"""<h2>What remains</h2>
+<p><b>{html.escape(VERDICT_WORDS.get(result.verdict, result.verdict))}</b>.
+The remainder is {state} (family p = {rem.p_value:.2g} over the signature kinds); its
+held-out error is {rem.excess:.2f} × the noise, {rem.share_of_gap:.0%} of the baseline's gap.</p>
+<table><tr><th>kind</th><th>acts in</th><th>closes of the remainder</th><th>p (family)</th>
+<th>evidence</th><th>fitted terms</th></tr>{rows}</table>
+{plot}
+"""
+
+
 def _table(rows: Mapping[str, object]) -> str:
     cells = "".join(
         f"<tr><th>{html.escape(str(k))}</th><td>{_fmt(v)}</td></tr>" for k, v in rows.items()
@@ -176,6 +253,7 @@ def write_report(directory: Path, traces: Sequence[Trace], result: Diagnosis) ->
     _residual_plot(directory / "residual.png", traces, result)
     _ranking_plot(directory / "ranking.png", result)
     _overlay_plot(directory / "overlay.png", traces, result)
+    plotted = _remainder_plot(directory / "remainder.png", traces, result)
     (directory / "result.json").write_text(json.dumps(result.to_dict(), indent=2))
     where = result.where
     ranking_rows = "".join(
@@ -191,7 +269,7 @@ def write_report(directory: Path, traces: Sequence[Trace], result: Diagnosis) ->
 td,th{{padding:2px 8px;text-align:left}} table{{border-collapse:collapse;margin:6px 0}}
 tr:nth-child(even){{background:#f3f3f3}}</style>
 </head><body>
-<h1>Diagnosis: <code>{html.escape(result.effect)}</code></h1>
+<h1>Diagnosis: <code>{html.escape(result.effect)}</code> ({html.escape(result.verdict)})</h1>
 <p>Recordings: {", ".join(html.escape(t.name) for t in traces)}.
 Held-out NRMSE {result.heldout_error_before:.4g} → {result.heldout_error_after:.4g}
 (noise alone {result.noise_floor:.4g}; gap closure in noise units {result.gap_closure:.2f};
@@ -202,6 +280,7 @@ bootstrap confidence {result.confidence:.2f}).</p>
 <table><tr><th>effect</th><th>held-out gap closure</th><th>screening</th>
 <th>fitted parameters</th></tr>
 {ranking_rows}</table>
+{_remainder_section(result, plotted)}
 <h2>Where the gap lies</h2>
 <p>Shares of the fitted baseline's squared residual.</p>
 <h3>by channel</h3>{_table(where.channel)}

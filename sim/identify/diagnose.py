@@ -356,7 +356,7 @@ def diagnose(
     ]
     remainder = remainder_of(
         traces, after_out, nominal, after_values, x_base,
-        where_the_gap_lies(traces, after_states),
+        where_the_gap_lies(traces, after_states), balances=not accepted,
     )  # fmt: skip
     timings["remainder"] = time.perf_counter() - started
     timings["total"] = time.perf_counter() - t0
@@ -403,8 +403,9 @@ def signature_rival(
     passing = [s for s in signatures if s.passes]
     if not passing:
         return None
-    best = passing[0]  # the lowest held-out error among those that pass
-    return best.kind if beats(traces, fits[best.kind].outputs, effect) else None
+    best = min(passing, key=lambda s: s.excess_after)
+    name = f"{best.kind} in {best.channel}"
+    return name if beats(traces, fits[name].outputs, effect) else None
 
 
 def strongest_accepted(

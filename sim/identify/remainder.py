@@ -24,7 +24,10 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
-from sim.identify.decide import ALPHA, Evidence, judge
+import numpy as np
+
+from sim.identify.balance import fit_balances
+from sim.identify.decide import ALPHA, Evidence, block_gains, family_p_values, p_value_of_gains
 from sim.identify.heldout import Outputs, heldout_excess
 from sim.identify.signature import Signature, SignatureFit, fit_signatures
 from sim.identify.traces import Trace
@@ -55,9 +58,10 @@ class Remainder:
     #: Share of the baseline's gap above the noise (X − 1) that remains.
     share_of_gap: float
     where: Where | None
-    #: Every kind, best held-out closure first; those that pass are the description.
+    #: Every kind, those that pass first (a formula before ``other``), then by held-out
+    #: error; those that pass are the description.
     signature: list[Signature] = field(default_factory=list)
-    #: The fits behind ``signature`` (for plots), by kind.
+    #: The fits behind ``signature`` (for plots), by ``SignatureFit.name``.
     fits: dict[str, SignatureFit] = field(default_factory=dict, repr=False)
 
     def to_dict(self) -> dict[str, object]:
@@ -78,30 +82,77 @@ def judge_signatures(
     outputs: Sequence[Outputs],
     nominal: StandParams,
     values: dict[str, float],
+    balances: bool = False,
 ) -> tuple[list[Signature], dict[str, SignatureFit], dict[str, Evidence]]:
-    """Every signature kind fitted to the remainder of ``outputs`` and judged as a family.
+    """Every signature variant fitted to the remainder of ``outputs``, judged as a family.
 
-    Returns the signatures (best held-out closure first), their fits and evidence by kind.
+    ``balances``: the force balances' variants too (``balance``; only where no effect is
+    named: they know none), in the same family — the same held-out blocks, the same
+    sign flips. Returns the signatures (those that pass first), the output-space fits
+    and the evidence, by name (a kind and where it acts).
     """
-    fits = {f.kind: f for f in fit_signatures(traces, outputs, nominal, values)}
-    evidence = judge(traces, outputs, {k: f.outputs for k, f in fits.items()})
+    fits = {f.name: f for f in fit_signatures(traces, outputs, nominal, values)}
+    names = list(fits)
+    rows = [block_gains(traces, outputs, fits[n].outputs) for n in names]
     x_before = heldout_excess(traces, outputs)
+    x_after = {n: heldout_excess(traces, fits[n].outputs) for n in names}
+    before = dict.fromkeys(names, x_before)
+    info = {n: (fits[n].kind, fits[n].channel, fits[n].formula, "outputs") for n in names}
+    if balances:
+        for fit in fit_balances(traces, nominal, values):
+            names.append(fit.name)
+            rows.append(np.log(np.maximum(fit.before, 1e-300) / np.maximum(fit.after, 1e-300)))
+            before[fit.name] = float(np.sqrt(np.mean(fit.before)))
+            x_after[fit.name] = float(np.sqrt(np.mean(fit.after)))
+            info[fit.name] = (fit.kind, fit.channel, fit.formula, "balances")
+    gains = np.stack(rows)
+    p_family = family_p_values(gains)
+    evidence = {}
     signatures = []
-    for kind, fit in fits.items():
-        ev = evidence[kind]
+    for name, g, p in zip(names, gains, p_family, strict=True):
+        ev = Evidence(before[name], x_after[name], p_value_of_gains(g), int(g.size), float(p))
+        evidence[name] = ev
+        kind, channel, formula, source = info[name]
         signatures.append(
             Signature(
                 kind=kind,
-                channel=fit.channel,
-                formula=fit.formula,
-                closes=(x_before - ev.x_after) / max(x_before - 1.0, 1e-12),
+                channel=channel,
+                formula=formula,
+                closes=_closes(ev) if source == "outputs" else _removes(ev),
                 excess_after=ev.x_after,
-                p_family=ev.corrected_p(len(fits)),
-                passes=ev.accepted(len(fits)),
+                p_family=ev.corrected_p(len(names)),
+                passes=ev.accepted(len(names)),
+                source=source,
             )
         )
-    signatures.sort(key=lambda s: (not s.passes, s.excess_after))
+    # Passing ones first; among them the balances' (instantaneous: no bounce blurs them)
+    # and a formula before ``other``, which only says that the remainder repeats with
+    # the motion (the training cycles' mean predicts anything that does); then the one
+    # that closes most.
+    signatures.sort(
+        key=lambda s: (not s.passes, s.source != "balances", s.kind == "other", -s.closes)
+    )
     return signatures, fits, evidence
+
+
+def _closes(ev: Evidence) -> float:
+    """Share of the remainder above the noise (X − 1) that a signature closes, in [−1, 1].
+
+    The noise is known to about a tenth, so a remainder near it can be closed "more than
+    all the way"; 0 where there is nothing above the noise.
+    """
+    if ev.x_before <= 1.0:
+        return 0.0
+    return min(max((ev.x_before - ev.x_after) / (ev.x_before - 1.0), -1.0), 1.0)
+
+
+def _removes(ev: Evidence) -> float:
+    """Share of the balances' held-out mean square error that a signature removes.
+
+    The balances' noise is their spread at rest, which the motion's can differ from by a
+    tenth either way: the share of the error is what their fit says without it.
+    """
+    return 1.0 - (ev.x_after / ev.x_before) ** 2 if ev.x_before > 0 else 0.0
 
 
 def remainder_of(
@@ -111,9 +162,13 @@ def remainder_of(
     values: dict[str, float],
     x_base: float,
     where: Where | None = None,
+    balances: bool = False,
 ) -> Remainder:
-    """The final model's remainder: judged, described, and its share of the baseline's gap."""
-    signatures, fits, _ = judge_signatures(traces, outputs, nominal, values)
+    """The final model's remainder: judged, described, and its share of the baseline's gap.
+
+    ``balances``: judge the force balances' variants too (where no effect is named).
+    """
+    signatures, fits, _ = judge_signatures(traces, outputs, nominal, values, balances)
     excess = heldout_excess(traces, outputs)
     passing = [s for s in signatures if s.passes]
     p_value = min((s.p_family for s in signatures), default=1.0)

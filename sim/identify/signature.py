@@ -51,6 +51,18 @@ __all__ = ["KINDS", "Signature", "SignatureFit", "fit_signatures"]
 
 #: The kinds of term a remainder can be described by (``other``: repeats, no formula).
 KINDS = ("position", "strain", "velocity", "resonance", "drift", "other")
+#: Each kind where it can act, fitted and judged apart: through the stand's dynamics
+#: (``u+F``: a physical term shows in both channels) or in one gauge's reading only (a
+#: sensor). Fitted together, a drift library's noise-following terms in u (a light
+#: weight's bounces) kept a force gauge's real drift from passing.
+VARIANTS = (
+    ("position", "u+F"), ("position", "u"), ("strain", "u+F"), ("velocity", "u+F"),
+    ("resonance", "u+F"), ("resonance", "F"), ("drift", "u"), ("drift", "F"),
+)  # fmt: skip
+_ROUTES = {"u+F": {"weight", "tension"}, "u": {"u"}, "F": {"F"}}
+#: The baseline's own parameters as library terms (stiffness, damping, friction), in every
+#: variant's fit and never dropped or shown.
+NUISANCE = "baseline"
 #: STLSQ drops a term whose scaled coefficient (noise units of the outputs it moves,
 #: rms over the training samples) is below this.
 THRESHOLD_NOISE = 0.2
@@ -59,6 +71,9 @@ STLSQ_ROUNDS = 10
 #: Ridge on the scaled columns (relative to the largest eigenvalue): libraries of
 #: neighbouring frequencies or speeds are nearly collinear.
 RIDGE = 1e-6
+#: Legendre orders of a force along the guide (over the campaign's span of u): up to a
+#: wave of one and a half periods over the span.
+POSITION_ORDERS = (1, 2, 3, 4, 5)
 #: Natural frequencies of the resonance library, Hz, and its damping ratio.
 RESONANCE_HZ = (15.0, 25.0, 40.0, 60.0, 90.0, 140.0, 220.0, 350.0)
 RESONANCE_ZETA = 0.05
@@ -89,15 +104,19 @@ class Signature:
     kind: str
     channel: str  # "u", "F", or "u+F" (a physical term shows in both)
     formula: str
-    #: Share of the remainder above the noise (X − 1) it closes on held-out cycles.
+    #: What it closes on held-out cycles: of the model's remainder above the noise
+    #: (X − 1, in [−1, 1]); of the balances' error (``source`` "balances").
     closes: float
     excess_after: float
     p_family: float = 1.0
     passes: bool = False
+    #: Where it was fitted: the model's held-out ``outputs``, or the force ``balances``.
+    source: str = "outputs"
 
     def to_dict(self) -> dict[str, object]:
-        """JSON keys kind, channel, formula, closes, excess_after, p_value, passes."""
+        """JSON keys kind, channel, formula, closes, excess_after, p_value, passes, source."""
         return {
+            "source": self.source,
             "kind": self.kind,
             "channel": self.channel,
             "formula": self.formula,
@@ -110,14 +129,19 @@ class Signature:
 
 @dataclass
 class SignatureFit:
-    """A kind fitted to a remainder: the adjusted outputs and what they say."""
+    """A kind fitted to a remainder in one place: the adjusted outputs and what they say."""
 
     kind: str
     outputs: list[Outputs]
-    channel: str
+    channel: str  # "u", "F", or "u+F" (through the stand's dynamics)
     formula: str
     #: The fitted terms' predicted remainder per trace (u, F), for plots.
     predicted: list[Outputs]
+
+    @property
+    def name(self) -> str:
+        """``kind`` in ``channel``, e.g. ``drift in F`` (a key among the variants)."""
+        return f"{self.kind} in {self.channel}"
 
 
 def _taut_filters(
@@ -164,7 +188,11 @@ class _Library:
     """The terms of every kind, with the campaign-wide scales that make them readable."""
 
     def __init__(
-        self, traces: Sequence[Trace], outputs: Sequence[Outputs], nominal: StandParams
+        self,
+        traces: Sequence[Trace],
+        outputs: Sequence[Outputs],
+        nominal: StandParams,
+        values: dict[str, float],
     ) -> None:
         self.traces = traces
         self.outputs = outputs
@@ -173,13 +201,29 @@ class _Library:
         tension = np.concatenate([o.force_n for o in outputs])
         self.t_ref = float(np.median(tension)) or 1.0
         self.radius = nominal.pulley_radius_m
+        self.k = nominal.stiffness_n_m * values.get("stiffness_scale", 1.0)
+        self.c = nominal.damping_n_s_m * values.get("damping_scale", 1.0)
+        self.n = nominal.projection
+        self.preload = nominal.preload_tension_n
+        self.friction_n = nominal.normal_force_n * values.get("friction_scale", 1.0)
+        self.v_reg = nominal.friction.v_reg_m_s if nominal.friction is not None else 1e-3
+
+    def elongation(self, i: int) -> FloatArray:
+        """The fibre's elongation from the measured drive and weight positions, m."""
+        tr = self.traces[i]
+        return np.asarray(self.preload / self.k + (tr.x_m - tr.x_m[0]) - self.n * tr.segments.u_m)
+
+    def elongation_rate(self, i: int) -> FloatArray:
+        """Its rate, m/s."""
+        tr = self.traces[i]
+        return np.asarray(np.gradient(tr.x_m, 1.0 / tr.rate_hz) - self.n * tr.segments.v_m_s)
 
     def terms(self, kind: str) -> list[Term]:
-        """The kind's terms, in the order ``series`` gives them."""
+        """The kind's terms, in the order ``series`` gives them (``NUISANCE``: the base's)."""
         span, v, t = f"{self.u_span * 1e3:.3g} mm", f"{self.v_top:.3g} m/s", f"{self.t_ref:.3g} N"
         if kind == "position":  # the guide (Legendre in u), a gauge, the pulley's turn
             return [
-                *(Term(kind, "weight", f"P{k}(u/{span})", "N") for k in (1, 2, 3)),
+                *(Term(kind, "weight", f"P{k}(u/{span})", "N") for k in POSITION_ORDERS),
                 *(Term(kind, "u", f"P{k}(u/{span})", "m") for k in (2, 3)),
                 *(Term(kind, "tension", f"{fn}({h}·x/r)", "N") for h in (1, 2)
                   for fn in ("sin", "cos")),
@@ -198,6 +242,12 @@ class _Library:
                 for hz in RESONANCE_HZ
                 for route in ("tension", "F")
             ]
+        if kind == NUISANCE:  # the baseline's own parameters, given their say again
+            return [
+                Term(kind, "tension", "k·e", "N"),
+                Term(kind, "tension", "c·ė", "N"),
+                Term(kind, "weight", "friction", "N"),
+            ]
         if kind == "drift":  # per recording and gauge
             return [
                 Term(kind, route, f"{tr.name}: P{o}(t)", unit)
@@ -214,7 +264,7 @@ class _Library:
         rows: list[FloatArray] = []
         if kind == "position":
             z = 2 * u / self.u_span - 1
-            rows += [_legendre(z, k) for k in (1, 2, 3)]
+            rows += [_legendre(z, k) for k in POSITION_ORDERS]
             rows += [_legendre(z, k) for k in (2, 3)]
             turn = (tr.x_m - tr.x_m[0]) / self.radius
             rows += [fn(h * turn) for h in (1, 2) for fn in (np.sin, np.cos)]
@@ -227,6 +277,9 @@ class _Library:
             for hz in RESONANCE_HZ:
                 mode = _mode_response(out.force_n, hz, tr.rate_hz)
                 rows += [mode, mode]
+        elif kind == NUISANCE:
+            rows += [self.elongation(i) * self.k, self.elongation_rate(i) * self.c]
+            rows += [-np.tanh(v / self.v_reg) * self.friction_n]
         elif kind == "drift":
             t = np.linspace(-1.0, 1.0, tr.samples)
             zero = np.zeros(tr.samples)
@@ -296,12 +349,17 @@ def _stack(
     return np.concatenate(chunks, axis=-1)
 
 
-def stlsq(design: FloatArray, target: FloatArray, threshold: float) -> FloatArray:
+def stlsq(
+    design: FloatArray,
+    target: FloatArray,
+    threshold: float,
+    always: NDArray[np.bool_] | None = None,
+) -> FloatArray:
     """Sequentially thresholded least squares (SINDy's STLSQ) on scaled columns.
 
     Columns are scaled to unit rms over the samples they touch (a drift term touches one
     recording's gauge), so ``threshold`` is the least rms (in the target's units) a kept
-    term moves the outputs it acts on.
+    term moves the outputs it acts on. ``always``: columns never dropped.
     """
     if design.shape[1] == 0:
         return np.zeros(0)
@@ -320,6 +378,8 @@ def stlsq(design: FloatArray, target: FloatArray, threshold: float) -> FloatArra
         sub = np.ix_(keep, keep)
         coef[keep] = np.linalg.solve(gram[sub] + ridge[sub], a[:, keep].T @ target)
         small = np.abs(coef) < threshold
+        if always is not None:
+            small &= ~always
         if not np.any(small & keep):
             break
         keep &= ~small
@@ -357,27 +417,16 @@ def _cycle_average(traces: Sequence[Trace], outputs: Sequence[Outputs]) -> list[
     return predicted
 
 
-def _channel(energy: dict[str, float]) -> str:
-    """Where a fit's predicted remainder lies: one gauge (a sensor) or both (physical).
-
-    ``energy``: its squared predicted remainder in noise units by route group (``u``,
-    ``F``: one gauge's reading; ``physical``: through the stand's dynamics). The group
-    with most of it names the channel.
-    """
-    top = max(energy, key=energy.__getitem__)
-    return "u+F" if top == "physical" or energy[top] <= 0 else top
-
-
 def fit_signatures(
     traces: Sequence[Trace],
     outputs: Sequence[Outputs],
     nominal: StandParams,
     values: dict[str, float],
 ) -> list[SignatureFit]:
-    """Every kind fitted to the remainder of ``outputs`` on the training cycles.
+    """Every variant (``VARIANTS``) fitted to the remainder of ``outputs``, training cycles.
 
     ``values``: the fitted baseline scales (the taut dynamics the terms pass through).
-    Each fit's ``outputs`` are the model's plus the kind's predicted remainder, to be
+    Each fit's ``outputs`` are the model's plus the variant's predicted remainder, to be
     judged on the held-out cycles like any candidate.
     """
     filters = [_taut_filters(tr.mass_kg, nominal, values, tr.rate_hz) for tr in traces]
@@ -389,18 +438,38 @@ def fit_signatures(
         for tr, o in zip(traces, outputs, strict=True)
     ]
     target = _stack(traces, residual, "train")
-    library = _Library(traces, outputs, nominal)
+    library = _Library(traces, outputs, nominal, values)
+    base_terms = library.terms(NUISANCE)
+    base = _responses(library, NUISANCE, base_terms, filters)
+    base_design = _stack(traces, base, "train")
     fits = []
     for kind in KINDS[:-1]:
-        mine = library.terms(kind)
-        responses = _responses(library, kind, mine, filters)
-        design = _stack(traces, responses, "train").T
-        coef = stlsq(design, target, THRESHOLD_NOISE)
-        used = np.flatnonzero(coef)
-        predicted = [Outputs(coef[used] @ du[used], coef[used] @ df[used]) for du, df in responses]
-        formula = " + ".join(_term_text(mine[j], coef[j]) for j in used) or "0"
-        channel = _channel(_energy(traces, [mine[j] for j in used], coef[used], responses, used))
-        fits.append(SignatureFit(kind, _added(outputs, predicted), channel, formula, predicted))
+        kind_terms = library.terms(kind)
+        kind_responses = _responses(library, kind, kind_terms, filters)
+        terms = [*kind_terms, *base_terms]
+        responses = [
+            (np.vstack([ku, bu]), np.vstack([kf, bf]))
+            for (ku, kf), (bu, bf) in zip(kind_responses, base, strict=True)
+        ]
+        stacked = np.vstack([_stack(traces, kind_responses, "train"), base_design])
+        for variant_kind, channel in VARIANTS:
+            if variant_kind != kind:
+                continue
+            # The kind's terms where it acts, and the baseline's parameters again: a
+            # baseline fit takes what it can of a missing term into k, c and friction
+            # (an oiled guide's drag: damping ×1.7, friction ×1.4), and that share must
+            # come back for the term to show.
+            rows = np.array([t.kind == NUISANCE or t.route in _ROUTES[channel] for t in terms])
+            always = np.array([t.kind == NUISANCE for t in terms])[rows]
+            coef = np.zeros(len(terms))
+            coef[rows] = stlsq(stacked[rows].T, target, THRESHOLD_NOISE, always)
+            used = np.flatnonzero(coef)
+            predicted = [
+                Outputs(coef[used] @ du[used], coef[used] @ df[used]) for du, df in responses
+            ]
+            shown = [j for j in used if terms[j].kind != NUISANCE]
+            formula = " + ".join(_term_text(terms[j], coef[j]) for j in shown) or "0"
+            fits.append(SignatureFit(kind, _added(outputs, predicted), channel, formula, predicted))
     averaged = _cycle_average(traces, outputs)
     fits.append(
         SignatureFit(
@@ -409,22 +478,6 @@ def fit_signatures(
         )
     )  # fmt: skip
     return fits
-
-
-def _energy(
-    traces: Sequence[Trace],
-    terms: Sequence[Term],
-    coef: FloatArray,
-    responses: Sequence[tuple[FloatArray, FloatArray]],
-    used: NDArray[np.intp],
-) -> dict[str, float]:
-    """Squared predicted remainder (noise units) of the used terms, by route group."""
-    energy = {"u": 0.0, "F": 0.0, "physical": 0.0}
-    for term, w, j in zip(terms, coef, used, strict=True):
-        group = term.route if term.route in ("u", "F") else "physical"
-        parts = [(du[j : j + 1], df[j : j + 1]) for du, df in responses]
-        energy[group] += float(np.sum((w * _stack(traces, parts, "train")) ** 2))
-    return energy
 
 
 def _added(outputs: Sequence[Outputs], predicted: Sequence[Outputs]) -> list[Outputs]:

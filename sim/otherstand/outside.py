@@ -79,16 +79,18 @@ def _guide_drag(rng: np.random.Generator) -> Params:
 
 
 def _anchor_resonance(rng: np.random.Generator) -> Params:
-    """The drive's end of the fibre on a carriage: a mode at 40–160 Hz, ζ 0.02–0.1.
+    """The drive's end of the fibre on a carriage: a mode at 15–60 Hz, ζ 0.02–0.1.
 
-    The force gauge and its clamp sit on the drive's carriage, a few hundred grams to
-    two kilograms on a slide and a belt or a screw: its mode along the fibre is tens to
-    a hundred and some Hz, lightly damped, excited by every change of the tension.
+    The force gauge and its clamp sit on the drive's carriage, half a kilogram to three
+    on a slide pulled by a toothed belt: a belt's stiffness of 10⁴–10⁵ N/m puts its
+    mode along the fibre at 15–60 Hz (as stiff as the fibre itself, or stiffer), lightly
+    damped, excited by every change of the tension. (A stiff screw drive's carriage,
+    above 100 Hz, only adds compliance that a fitted fibre stiffness takes up.)
     """
     return {
-        "frequency_hz": _log_uniform(rng, 40.0, 160.0),
+        "frequency_hz": _log_uniform(rng, 15.0, 60.0),
         "damping_ratio": _log_uniform(rng, 0.02, 0.1),
-        "mass_kg": _log_uniform(rng, 0.3, 2.0),
+        "mass_kg": _log_uniform(rng, 0.5, 3.0),
     }
 
 

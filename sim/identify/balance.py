@@ -1,0 +1,340 @@
+"""The stand's two balances read off the recordings: what force or tension is missing.
+
+A term the model lacks shows in the model's output error only through the stand's
+dynamics, and a light weight's bounces make that error chaotic. The balances themselves
+are instantaneous: with the recorded (low-passed) u, x and F,
+
+* the fibre's law: g = F − (k·e + c·ė), e = T₀/k + x − n·u, on a taut fibre;
+* the weight's balance: f = m·ü − n·F + m·g·sin α + F_f(u̇), while it slides;
+
+are zero but for noise on a stand the baseline describes (the equation error of SINDy's
+regression; Brunton, Proctor and Kutz 2016). A missing term appears where it acts
+(``signature``'s routes): a force on the weight in f; a tension in the fibre's law in g;
+a force reading's error d in both, as (d, −n·d); a displacement reading's error w as
+(k·n·w + c·n·ẇ, m·ẅ). So each library term has a column in each balance; a variant's
+terms and the baseline's own parameters (k, c, the friction's scale, a constant force:
+what a baseline fit may have taken from the term) are fitted by STLSQ on the training
+cycles and judged on the held-out cycles' blocks, like every candidate.
+
+The balances know no candidate effect, so they describe a gap only where none is named.
+Each balance is in units of its own noise, its spread over the rest before the motion.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.signal import butter, sosfiltfilt
+
+from sim.identify.heldout import BLOCK_S
+from sim.identify.signature import (
+    DRIFT_ORDERS,
+    POSITION_ORDERS,
+    THRESHOLD_NOISE,
+    VELOCITY_SCALES_M_S,
+    _legendre,
+    _mode_response,
+    stlsq,
+)
+from sim.identify.traces import Trace
+from sim.params import StandParams
+
+FloatArray = NDArray[np.float64]
+BoolArray = NDArray[np.bool_]
+
+__all__ = ["BALANCE_VARIANTS", "BalanceFit", "fit_balances"]
+
+#: The recorded channels are low-passed (zero phase) here before they are
+#: differentiated: the weight's acceleration from a 5 µm dial gauge is noise above it.
+LOWPASS_HZ = 100.0
+#: Modes of the resonance library, Hz: below the low-pass.
+BALANCE_MODES_HZ = (15.0, 22.0, 32.0, 45.0, 65.0)
+#: The weight counts as sliding above this speed (a stuck weight's friction is whatever
+#: holds it, which no law gives), m/s.
+SLIDING_M_S = 5e-3
+#: The rest before the motion whose spread is each balance's noise, s (after the
+#: low-pass's start-up).
+REST_S = (0.05, 0.4)
+#: The kinds and where they act, as ``signature.VARIANTS`` (``u+F``: a physical term).
+BALANCE_VARIANTS = (
+    ("position", "u+F"), ("position", "u"), ("strain", "u+F"), ("velocity", "u+F"),
+    ("resonance", "u+F"), ("resonance", "F"), ("drift", "u"), ("drift", "F"),
+)  # fmt: skip
+
+
+@dataclass
+class _Balances:
+    """One trace's balances and what the library is made of (low-passed, SI)."""
+
+    u: FloatArray
+    v: FloatArray
+    x: FloatArray
+    force: FloatArray
+    e: FloatArray
+    e_rate: FloatArray
+    friction: FloatArray
+    g: FloatArray
+    f: FloatArray
+    use_g: BoolArray
+    use_f: BoolArray
+    noise_g: float
+    noise_f: float
+
+
+def _lowpass(series: FloatArray, rate_hz: float) -> FloatArray:
+    ok = np.isfinite(series)
+    idx = np.arange(series.size)
+    filled = np.interp(idx, idx[ok], series[ok]) if not ok.all() else series
+    if 0.45 * rate_hz <= LOWPASS_HZ:
+        return np.asarray(filled, dtype=np.float64)
+    sos = butter(4, LOWPASS_HZ / (rate_hz / 2), output="sos")
+    return np.asarray(sosfiltfilt(sos, filled, padtype="constant"), dtype=np.float64)
+
+
+def _balances(tr: Trace, nominal: StandParams, values: dict[str, float]) -> _Balances:
+    rate, n = tr.rate_hz, nominal.projection
+    k = nominal.stiffness_n_m * values.get("stiffness_scale", 1.0)
+    c = nominal.damping_n_s_m * values.get("damping_scale", 1.0)
+    gauge = tr.dial_slope * n if np.isfinite(tr.dial_slope) else 1.0  # the dial's scale
+    u = _lowpass(tr.u_m, rate) / gauge
+    x = _lowpass(tr.x_m - tr.x_m[0], rate)
+    force = _lowpass(tr.force_n, rate)
+    v = np.gradient(u, 1.0 / rate)
+    a = np.gradient(v, 1.0 / rate)
+    e = nominal.preload_tension_n / k + x - n * u
+    e_rate = np.gradient(x, 1.0 / rate) - n * v
+    normal = nominal.normal_force_n * values.get("friction_scale", 1.0)
+    friction = (
+        nominal.friction.force_n(v, normal) if nominal.friction is not None else np.zeros_like(v)
+    )
+    g = force - (k * e + c * e_rate)
+    f = tr.mass_kg * a - n * force + nominal.gravity_along_n + friction
+    present = tr.present.copy()
+    use_g = present & (force > 0.2 * np.median(force)) & (e > 0)
+    use_f = present & (np.abs(v) > SLIDING_M_S)
+    rest = slice(int(REST_S[0] * rate), max(int(REST_S[1] * rate), int(REST_S[0] * rate) + 10))
+    noise_g = float(np.std(g[rest])) or 1.0
+    noise_f = float(np.std(f[rest])) or 1.0
+    return _Balances(u, v, x, force, e, e_rate, friction, g, f, use_g, use_f, noise_g, noise_f)
+
+
+@dataclass(frozen=True)
+class _Column:
+    name: str
+    unit: str
+    route: str  # "weight", "tension", "u", "F", or "base" (the baseline's own)
+
+
+class _BalanceLibrary:
+    """The terms of every kind as columns of the two balances, trace by trace."""
+
+    def __init__(
+        self,
+        traces: Sequence[Trace],
+        balances: Sequence[_Balances],
+        nominal: StandParams,
+        values: dict[str, float],
+    ) -> None:
+        self.traces, self.balances = traces, balances
+        self.n = nominal.projection
+        self.k = nominal.stiffness_n_m * values.get("stiffness_scale", 1.0)
+        self.c = nominal.damping_n_s_m * values.get("damping_scale", 1.0)
+        self.radius = nominal.pulley_radius_m
+        self.u_span = max([float(np.ptp(b.u)) for b in balances] + [1e-6])
+        self.v_top = max([float(np.max(np.abs(b.v))) for b in balances] + [1e-6])
+        self.t_ref = float(np.median(np.concatenate([b.force for b in balances]))) or 1.0
+        self._cache: dict[tuple[str, int], tuple[list[_Column], FloatArray, FloatArray]] = {}
+
+    def columns(self, kind: str, i: int) -> tuple[list[_Column], FloatArray, FloatArray]:
+        """The kind's terms on trace ``i``: their names, and their (g, f) columns."""
+        key = (kind, i)
+        if key not in self._cache:
+            self._cache[key] = self._columns(kind, i)
+        return self._cache[key]
+
+    def _columns(self, kind: str, i: int) -> tuple[list[_Column], FloatArray, FloatArray]:
+        tr, b = self.traces[i], self.balances[i]
+        names: list[_Column] = []
+        g_cols: list[FloatArray] = []
+        f_cols: list[FloatArray] = []
+        zero = np.zeros(tr.samples)
+
+        def add(name: str, unit: str, route: str, series: FloatArray) -> None:
+            names.append(_Column(name, unit, route))
+            if route in ("weight",):
+                g_cols.append(zero)
+                f_cols.append(series)
+            elif route in ("tension",):
+                g_cols.append(series)
+                f_cols.append(zero)
+            elif route == "F":  # the reading F = T + d
+                g_cols.append(series)
+                f_cols.append(-self.n * series)
+            elif route == "u":  # the reading u = u_true + w
+                rate = tr.rate_hz
+                w_rate = np.gradient(series, 1.0 / rate)
+                g_cols.append(self.k * self.n * series + self.c * self.n * w_rate)
+                f_cols.append(tr.mass_kg * np.gradient(w_rate, 1.0 / rate))
+            else:  # the baseline's own: (g, f) given as a pair by the caller
+                raise ValueError(route)
+
+        z = 2 * b.u / self.u_span - 1
+        span = f"{self.u_span * 1e3:.3g} mm"
+        if kind == "position":
+            for o in POSITION_ORDERS:
+                add(f"P{o}(u/{span})", "N", "weight", _legendre(z, o))
+            for o in (2, 3):
+                add(f"P{o}(u/{span})", "m", "u", _legendre(z, o))
+            turn = b.x / self.radius
+            for h in (1, 2):
+                add(f"sin({h}·x/r)", "N", "tension", np.sin(h * turn))
+                add(f"cos({h}·x/r)", "N", "tension", np.cos(h * turn))
+        elif kind == "strain":
+            for p in (2, 3):
+                add(f"(T/{self.t_ref:.3g} N)^{p}", "N", "tension",
+                    (np.maximum(b.force, 0.0) / self.t_ref) ** p)  # fmt: skip
+        elif kind == "velocity":
+            vt = f"{self.v_top:.3g} m/s"
+            add(f"v/{vt}", "N", "weight", b.v / self.v_top)
+            add(f"v·|v|/({vt})²", "N", "weight", b.v * np.abs(b.v) / self.v_top**2)
+            for s in VELOCITY_SCALES_M_S:
+                add(f"tanh(v/{s:g} m/s)", "N", "weight", np.tanh(b.v / s))
+        elif kind == "resonance":
+            for hz in BALANCE_MODES_HZ:
+                mode = _mode_response(b.force, hz, tr.rate_hz)
+                add(f"mode {hz:g} Hz of T", "N", "tension", mode)
+                add(f"mode {hz:g} Hz of T", "N", "F", mode)
+        elif kind == "drift":
+            t = np.linspace(-1.0, 1.0, tr.samples)
+            for j, other in enumerate(self.traces):
+                for o in DRIFT_ORDERS:
+                    poly = _legendre(t, o) if j == i else zero
+                    add(f"{other.name}: P{o}(t)", "m", "u", poly)
+                    add(f"{other.name}: P{o}(t)", "N", "F", poly)
+        elif kind == "base":
+            # k, c, the friction's scale, a constant force along the guide (the incline),
+            # and each recording's own tension offset (its preload, its gauge's zero).
+            names += [_Column(nm, "", "base") for nm in ("k·e", "c·ė", "friction", "force")]
+            g_cols += [self.k * b.e, self.c * b.e_rate, zero, zero]
+            f_cols += [zero, zero, b.friction, np.ones(tr.samples)]
+            for j, other in enumerate(self.traces):
+                names.append(_Column(f"{other.name}: T offset", "", "base"))
+                g_cols.append(np.ones(tr.samples) if j == i else zero)
+                f_cols.append(zero)
+        return (
+            names,
+            np.asarray(g_cols).reshape(-1, tr.samples),
+            np.asarray(f_cols).reshape(-1, tr.samples),
+        )
+
+
+@dataclass
+class BalanceFit:
+    """A variant fitted to the balances: its formula and its held-out blocks' errors."""
+
+    kind: str
+    channel: str
+    formula: str
+    #: Mean squared balance error (noise units) per held-out block, before and after.
+    before: FloatArray
+    after: FloatArray
+
+    @property
+    def name(self) -> str:
+        """``kind in channel`` of the balances."""
+        return f"{self.kind} in {self.channel} (balances)"
+
+
+_ROUTES = {"u+F": {"weight", "tension"}, "u": {"u"}, "F": {"F"}}
+
+
+def _blocks(tr: Trace) -> list[NDArray[np.intp]]:
+    """The held-out blocks as ``heldout.block_errors`` cuts them (sample indices)."""
+    idx = tr.test
+    out: list[NDArray[np.intp]] = []
+    for cyc in np.unique(tr.cycle[idx]):
+        samples = np.flatnonzero(idx & (tr.cycle == cyc))
+        pieces = max(1, int(samples.size // (BLOCK_S * tr.rate_hz)))
+        out += list(np.array_split(samples, pieces))
+    return out
+
+
+def fit_balances(
+    traces: Sequence[Trace], nominal: StandParams, values: dict[str, float]
+) -> list[BalanceFit]:
+    """Every variant of ``BALANCE_VARIANTS`` fitted to the balances (see the module)."""
+    balances = [_balances(tr, nominal, values) for tr in traces]
+    library = _BalanceLibrary(traces, balances, nominal, values)
+
+    def design(kind: str, which: str) -> tuple[list[_Column], FloatArray, FloatArray]:
+        """Columns (terms × samples) and target over the chosen samples of every trace."""
+        cols, target = [], []
+        names: list[_Column] = []
+        for i, (tr, b) in enumerate(zip(traces, balances, strict=True)):
+            names, g_cols, f_cols = library.columns(kind, i)
+            part = tr.train if which == "train" else np.ones(tr.samples, dtype=bool)
+            sg, sf = part & b.use_g, part & b.use_f
+            cols.append(np.hstack([g_cols[:, sg] / b.noise_g, f_cols[:, sf] / b.noise_f]))
+            target.append(np.concatenate([b.g[sg] / b.noise_g, b.f[sf] / b.noise_f]))
+        return names, np.hstack(cols), np.concatenate(target)
+
+    base_names, base_train, target = design("base", "train")
+    base_coef = stlsq(base_train.T, target, 0.0, np.ones(len(base_names), dtype=bool))
+    before = _block_errors(traces, balances, library, "base", base_coef)
+    fits = []
+    for kind in dict.fromkeys(k for k, _ in BALANCE_VARIANTS):
+        names, train, _ = design(kind, "train")
+        for variant, channel in BALANCE_VARIANTS:
+            if variant != kind:
+                continue
+            rows = np.array([c.route in _ROUTES[channel] for c in names])
+            stacked = np.vstack([train[rows], base_train])
+            always = np.r_[np.zeros(int(rows.sum()), dtype=bool), np.ones(len(base_names), bool)]
+            coef = stlsq(stacked.T, target, THRESHOLD_NOISE, always)
+            mine = np.zeros(len(names))
+            mine[rows] = coef[: int(rows.sum())]
+            after = _block_errors(
+                traces, balances, library, kind, mine, base_coef=coef[int(rows.sum()) :]
+            )
+            formula = " + ".join(_text(c, w) for c, w in zip(names, mine, strict=True) if w != 0.0)
+            fits.append(BalanceFit(kind, channel, formula or "0", before, after))
+    return fits
+
+
+def _block_errors(
+    traces: Sequence[Trace],
+    balances: Sequence[_Balances],
+    library: _BalanceLibrary,
+    kind: str,
+    coef: FloatArray,
+    base_coef: FloatArray | None = None,
+) -> FloatArray:
+    """Mean squared balance error (noise units) of every held-out block after a fit."""
+    errors = []
+    for i, (tr, b) in enumerate(zip(traces, balances, strict=True)):
+        _, g_cols, f_cols = library.columns(kind, i)
+        g_fit = coef @ g_cols
+        f_fit = coef @ f_cols
+        if base_coef is not None:
+            _, bg, bf = library.columns("base", i)
+            g_fit = g_fit + base_coef @ bg
+            f_fit = f_fit + base_coef @ bf
+        rg = np.where(b.use_g, (b.g - g_fit) / b.noise_g, np.nan)
+        rf = np.where(b.use_f, (b.f - f_fit) / b.noise_f, np.nan)
+        for sel in _blocks(tr):
+            both = np.concatenate([rg[sel], rf[sel]])
+            both = both[np.isfinite(both)]
+            errors.append(float(np.mean(both**2)) if both.size else 0.0)
+    return np.asarray(errors, dtype=np.float64)
+
+
+_WHERE = {"weight": "force on the weight", "tension": "fibre tension", "u": "u reading",
+          "F": "F reading"}  # fmt: skip
+
+
+def _text(column: _Column, weight: float) -> str:
+    value, unit = (weight * 1e3, "mm") if column.unit == "m" else (weight, column.unit)
+    return f"{value:+.3g} {unit}·{column.name} [{_WHERE[column.route]}]"
