@@ -14,9 +14,15 @@ The gap is measured on held-out cycles, in noise units.
    none's is, ``none``.
    Candidates that do about as well are named beside it (the recordings cannot tell
    them apart).
-5. A real stand has more than one effect: on top of the accepted one, the next best
-   candidates are refitted together with it and judged against it the same way.
-6. Attribute the residual of the baseline (``where``) and say how far the gap shrank.
+5. A real stand has more than one effect: on top of those accepted, the next best
+   candidates are refitted together with them and judged against them the same way, up
+   to ``MAX_EFFECTS``. An effect that passes its test is named only if no signature of
+   the remainder it closes (``remainder``: a term of the library, fitted freely) beats
+   it: a catalogue effect can soak up a gap of another kind, or a first effect's form
+   mismatch.
+6. Judge what remains (``remainder``): a systematic remainder or none, and what it is
+   like; the verdict joins it with the effects named.
+7. Attribute the residual of the baseline (``where``) and say how far the gap shrank.
 """
 
 from __future__ import annotations
@@ -83,6 +89,8 @@ POLISH_EVALUATIONS = 40
 #: pulley behind a ratchet: third by its training cost alone; a heavy one behind a gauge
 #: low-pass: third on the score test). Three and two named 24.
 SECOND_STAGE = 3
+#: Effects named at most, one at a time (the first, then further ones on top).
+MAX_EFFECTS = 4
 #: A runner-up is "indistinguishable" from the chosen effect unless the chosen one beats
 #: it on held-out cycles at this one-sided p-value (and by a gain X resolves: ``beats``).
 DISTINCT_P = 0.05
@@ -322,22 +330,27 @@ def diagnose(
         started = time.perf_counter()
         trained = {e: f.result.train_cost for e, f in refits.items()}
         alone = {e: _own_values(e, f.result.values) for e, f in refits.items()}
-        second, second_sims = _second_effect(
-            best, current, trained, alone, base_fit.train_cost, pool, traces, nominal, x_base,
-            say,
-        )  # fmt: skip
-        sims += second_sims
-        timings["second_effect"] = time.perf_counter() - started
-        if second is not None:
+        # Further effects, one at a time on top of those named (``MAX_EFFECTS``), each
+        # judged against the model before it and against a signature of its remainder.
+        while len(accepted) < MAX_EFFECTS:
+            named = tuple(a.effect for a in accepted)
+            further, further_sims = _further_effect(
+                named, current, trained, alone, base_fit.train_cost, pool, traces, nominal,
+                x_base, say,
+            )  # fmt: skip
+            sims += further_sims
+            if further is None:
+                break
             rival = signature_rival(
-                traces, current.outputs, nominal, current.result.values, second[1].outputs
+                traces, current.outputs, nominal, current.result.values, further[1].outputs
             )
-            if rival is None:
-                accepted.append(second[0])
-                current = second[1]
-            else:
-                say(f"{second[0].effect} does no better than a {rival} term: not named")
-                displaced[second[0].effect] = rival
+            if rival is not None:
+                say(f"{further[0].effect} does no better than a {rival} term: not named")
+                displaced[further[0].effect] = rival
+                break
+            accepted.append(further[0])
+            current = further[1]
+        timings["further_effects"] = time.perf_counter() - started
         after_out = current.outputs
         after_values = current.result.values
     x_after = heldout_excess(traces, after_out)
@@ -400,7 +413,7 @@ def signature_rival(
     24.4) with a 100 N pulley eccentricity.
     """
     signatures, fits, _ = judge_signatures(traces, before, nominal, values)
-    passing = [s for s in signatures if s.passes]
+    passing = [s for s in signatures if s.passes]  # at the remainder's own rate
     if not passing:
         return None
     best = min(passing, key=lambda s: s.excess_after)
@@ -485,8 +498,8 @@ def beats(traces: Sequence[Trace], chosen: Sequence[Outputs], other: Sequence[Ou
     return compare(traces, other, chosen).accepted(tests=1, alpha=DISTINCT_P)
 
 
-def _second_effect(
-    first: str,
+def _further_effect(
+    named: tuple[str, ...],
     current: _Fitted,
     trained: dict[str, float],
     alone: dict[str, dict[str, float]],
@@ -497,21 +510,24 @@ def _second_effect(
     x_base: float,
     say: Progress,
 ) -> tuple[tuple[AcceptedEffect, _Fitted] | None, int]:
-    """The best further effect on top of ``first``, if the held-out cycles say so.
+    """The best further effect on top of those ``named``, if the held-out cycles say so.
 
-    The candidates tried are the best by a score test on top of ``first`` (screening
-    with its fit as the base, on the training cycles) — an effect that the first one
+    The candidates tried are the best by a score test on top of those named (screening
+    with their fit as the base, on the training cycles) — an effect that the first one
     hides explains nothing alone until the first is modelled — and the best by their
     training cost alone on the baseline (``trained``, below the baseline's ``base_cost``;
     a Maxwell branch that a force skew mimics in the score test). Both are chosen on the
-    training cycles, so the held-out ones judge them unseen, as one family against
-    ``first``. (Chosen by their held-out closure alone, a heavy pulley's inertia behind a
+    training cycles, so the held-out ones judge them unseen, as one family against the
+    model of those named. (Chosen by their held-out closure alone, a heavy pulley's inertia behind a
     gauge low-pass was never tried: its refit fitted the training cycles third best,
     0.028 against the baseline's 0.039, but closed −0.2 against the best baseline.)
     Each try's start grid also holds its own refit alone (``alone``: its parameters
     there), a basin the training cycles have shown already.
     """
-    others = [e for e in pool if e != first]
+    first = "+".join(named)
+    others = [e for e in pool if e not in named]
+    if not others:
+        return None, 0
     say(f"screening the other effects on top of {first}")
     scores, probes, sims = screen(traces, nominal, current.result, current.outputs, others)
     tries = second_tries(others, scores, trained, base_cost)
@@ -522,7 +538,7 @@ def _second_effect(
         probe += _data_starts(effect, traces, nominal, current.result.values)
         probe += [alone[effect]] if effect in alone else []
         fits[effect] = _refit(
-            Candidate.build(first, effect), traces, nominal, current.result.values, probe
+            Candidate.build(*named, effect), traces, nominal, current.result.values, probe
         )
         sims += fits[effect].result.evaluations
     evidence = judge(traces, current.outputs, {e: f.outputs for e, f in fits.items()})
@@ -547,7 +563,7 @@ def _second_effect(
 def second_tries(
     others: Sequence[str], scores: dict[str, float], trained: dict[str, float], base_cost: float
 ) -> list[str]:
-    """The candidates tried on top of the first (``_second_effect``), in order.
+    """The candidates tried on top of those named (``_further_effect``), in order.
 
     ``SECOND_STAGE`` best by the score test on top (``scores``, only those above 0), then
     up to ``SECOND_STAGE`` best by their training cost alone (``trained``) among those

@@ -8,8 +8,8 @@ confirm. Every kind of term of the signature library (``signature``) is fitted t
 training cycles' remainder and predicts the held-out cycles'; the kinds are judged as
 one family against the model by the effects' own test (``decide.judge``): random sign
 flips of whole held-out blocks, maxT over the kinds. A remainder stands if some kind's
-gain passes at ``ALPHA``: a model that is right is called inadequate at most that often,
-by construction, whatever the noise.
+gain passes at ``REMAINDER_ALPHA``: a model that is right is called inadequate at most
+that often, by construction, whatever the noise.
 
 The verdict joins that with the named effects (``VERDICTS``):
 
@@ -37,6 +37,10 @@ from sim.params import StandParams
 __all__ = ["VERDICTS", "Remainder", "judge_signatures", "remainder_of", "verdict"]
 
 VERDICTS = ("baseline_adequate", "explained", "partly_explained", "unexplained")
+#: Family-wise false-alarm rate of the remainder's test. A right model can be called
+#: wrong by either test (an effect named, or a remainder beyond the noise), so their
+#: rates add: half the effects' ``ALPHA`` keeps the two together near it.
+REMAINDER_ALPHA = ALPHA / 2
 #: The verdicts in words (the CLI's first line).
 VERDICT_WORDS = {
     "baseline_adequate": "baseline adequate: no systematic gap beyond the noise",
@@ -99,7 +103,7 @@ def judge_signatures(
     before = dict.fromkeys(names, x_before)
     info = {n: (fits[n].kind, fits[n].channel, fits[n].formula, "outputs") for n in names}
     if balances:
-        for fit in fit_balances(traces, nominal, values):
+        for fit in fit_balances(traces, outputs, nominal, values):
             names.append(fit.name)
             rows.append(np.log(np.maximum(fit.before, 1e-300) / np.maximum(fit.after, 1e-300)))
             before[fit.name] = float(np.sqrt(np.mean(fit.before)))
@@ -121,7 +125,7 @@ def judge_signatures(
                 closes=_closes(ev) if source == "outputs" else _removes(ev),
                 excess_after=ev.x_after,
                 p_family=ev.corrected_p(len(names)),
-                passes=ev.accepted(len(names)),
+                passes=ev.accepted(len(names), REMAINDER_ALPHA),
                 source=source,
             )
         )
@@ -189,7 +193,3 @@ def verdict(named: bool, remainder: Remainder) -> str:
     if named:
         return "partly_explained" if remainder.beyond_noise else "explained"
     return "unexplained" if remainder.beyond_noise else "baseline_adequate"
-
-
-#: The family-wise false-alarm rate of the remainder's test (the effects' own).
-REMAINDER_ALPHA = ALPHA

@@ -298,16 +298,18 @@ def _legendre(z: FloatArray, order: int) -> FloatArray:
 
 
 @lru_cache(maxsize=64)
-def _mode_filter(hz: float, rate_hz: float) -> Filter:
+def _mode_filter(hz: float, rate_hz: float, zeta: float) -> Filter:
     w = 2 * np.pi * hz
-    b, a, _ = cont2discrete(([w * w], [1.0, 2 * RESONANCE_ZETA * w, w * w]), 1.0 / rate_hz,
+    b, a, _ = cont2discrete(([w * w], [1.0, 2 * zeta * w, w * w]), 1.0 / rate_hz,
                             method="bilinear")  # fmt: skip
     return np.ravel(b), np.ravel(a)
 
 
-def _mode_response(force: FloatArray, hz: float, rate_hz: float) -> FloatArray:
+def _mode_response(
+    force: FloatArray, hz: float, rate_hz: float, zeta: float = RESONANCE_ZETA
+) -> FloatArray:
     """The dynamic part of the tension through a damped mode (zero while it is steady)."""
-    b, a = _mode_filter(hz, rate_hz)
+    b, a = _mode_filter(hz, rate_hz, zeta)
     base = force - force[0]
     return np.asarray(lfilter(b, a, base) - base)
 
