@@ -342,8 +342,9 @@ def diagnose(
             if further is None:
                 break
             rival = signature_rival(
-                traces, current.outputs, nominal, current.result.values, further[1].outputs
-            )
+                traces, current.outputs, nominal, current.result.values, further[1].outputs,
+                further=True,
+            )  # fmt: skip
             if rival is not None:
                 say(f"{further[0].effect} does no better than a {rival} term: not named")
                 displaced[further[0].effect] = rival
@@ -401,23 +402,38 @@ def signature_rival(
     nominal: StandParams,
     values: dict[str, float],
     effect: Sequence[Outputs],
+    further: bool = False,
 ) -> str | None:
-    """The kind of library term that predicts better than an effect, or None.
+    """The kind of library term an effect does not beat on held-out cycles, or None.
 
     A catalogue effect that fits a gap of another kind closes part of it (a gauge's gain
-    soaks up a drifting force offset): it is not named if a signature of the remainder
-    (``signature``) that is itself evidence beats it on the held-out cycles (``beats``).
-    Where neither beats the other the effect stands: it has a handful of physical
+    soaks up a drifting force offset): the first effect is not named if a signature of
+    the remainder (``signature``) that is itself evidence beats it (``beats``). Where
+    neither beats the other the first effect stands: it has a handful of physical
     parameters against the library's dozen free terms, which over two short recordings
     fitted a Maxwell branch with a gauge's gain as well as the branch did (X 23.8 against
     24.4) with a 100 N pulley eccentricity.
+
+    A ``further`` effect, on top of those named, must itself beat the best of the
+    library's terms fitted to the named model's remainder, whether they pass or not:
+    those terms are a richer form of the model it extends, and a further effect that
+    does no better only soaks up the named ones' form mismatch (a dial gauge's backlash
+    named as a channel's time skew).
     """
     signatures, fits, _ = judge_signatures(traces, before, nominal, values)
-    passing = [s for s in signatures if s.passes]  # at the remainder's own rate
-    if not passing:
+    # A further effect against the terms with a formula (``other``, the training cycles'
+    # mean, is no form of any model: it predicts whatever repeats).
+    pool = (
+        [s for s in signatures if s.kind != "other"]
+        if further
+        else [s for s in signatures if s.passes]
+    )
+    if not pool:
         return None
-    best = min(passing, key=lambda s: s.excess_after)
+    best = min(pool, key=lambda s: s.excess_after)
     name = f"{best.kind} in {best.channel}"
+    if further:
+        return None if beats(traces, effect, fits[name].outputs) else name
     return name if beats(traces, fits[name].outputs, effect) else None
 
 
