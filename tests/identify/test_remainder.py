@@ -10,7 +10,7 @@ from scipy.signal import lfilter
 
 from sim.config import StandConfig
 from sim.identify import diagnose, make_trace
-from sim.identify.check import make_campaign, recording_set
+from sim.identify.check import CaseSpec, make_campaign, recording_set
 from sim.identify.remainder import judge_signatures, verdict
 from sim.identify.signature import _taut_filters, stlsq
 from sim.identify.traces import Trace
@@ -160,3 +160,18 @@ def test_an_effect_outside_the_catalogue_is_unexplained_and_described_by_its_kin
     best = next(s for s in result.remainder.signature if s.passes)
     assert best.kind == kind
     assert best.closes > 0.1
+
+
+def test_a_single_effect_of_another_form_names_no_second_effect(stand: StandConfig) -> None:
+    # The other stand's dial gauge (seed 1, light weight): gain 1.034 with a curvature
+    # and 9 µm of backlash, which our gauge candidate lacks. A time skew soaked up the
+    # backlash as a second effect; a quadratic term of the library does as well, so the
+    # skew is no evidence of a second effect.
+    rng = CaseSpec("dial_gauge_calibration", LIGHT, 0, 1).rng()
+    traces, _, _ = make_campaign(
+        stand, "dial_gauge_calibration", LIGHT, rng, truth_stand="other",
+        other_campaign=recording_set("moderate", stand),
+    )  # fmt: skip
+    result = diagnose(traces, stand.stand_params("final", LIGHT), CANDIDATES)
+    assert [e.effect for e in result.effects] == ["dial_gauge_calibration"]
+    assert "channel_time_skew" in result.displaced
