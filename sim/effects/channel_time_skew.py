@@ -50,5 +50,7 @@ INFO = EffectInfo(
               why="as the force channel's"),
     ),
     true_channels=_true_channels,
+    # Richer forms: a delay that depends on frequency: a filter on the force reading.
+    richer=(("resonance", "F"),),
 )
 # fmt: on

@@ -27,5 +27,7 @@ INFO = EffectInfo(
         param("offset_m", "m", 0.0, (-2.0e-4, 2.0e-4), (-0.01, 0.01), ek.R_DG_OFFSET,
               "reading at u = 0", fit=False, drawn=True),
     ),
+    # Richer forms: curvature, backlash, creep: the u reading by position or time.
+    richer=(("position", "u"), ("velocity", "u"), ("drift", "u")),
 )
 # fmt: on

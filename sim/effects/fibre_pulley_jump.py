@@ -90,5 +90,7 @@ INFO = EffectInfo(
                   "0.1–2 mm before the flange stops it"),
     ),
     start_state=_start_state,
+    # Richer forms: more seats, a creeping seat: a force with position, a slow u offset.
+    richer=(("position", "u+F"), ("drift", "u")),
 )
 # fmt: on

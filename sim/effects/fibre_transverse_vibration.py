@@ -31,5 +31,7 @@ INFO = EffectInfo(
               "tilt of the (vertical) drive span from the vertical", fit=False),
     ),
     carried=True,
+    # Richer forms: more modes, other damping: a mode of the tension.
+    richer=(("resonance", "u+F"),),
 )
 # fmt: on

@@ -58,5 +58,7 @@ INFO = EffectInfo(
                   "cycle (≈ 1–2.5 s) it is extra stiffness that k absorbs"),
     ),
     start_state=_start_state,
+    # Richer forms: another relaxation branch or a nonlinear law: a filtered or curved tension.
+    richer=(("strain", "u+F"), ("resonance", "u+F")),
 )
 # fmt: on

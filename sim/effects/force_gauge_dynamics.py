@@ -26,5 +26,7 @@ INFO = EffectInfo(
               why="a lightly damped load cell 0.2; Butterworth/Bessel filters 0.7–0.9; "
                   "cascaded RC stages overdamped"),
     ),
+    # Richer forms: another order or resonance of the gauge: a mode in the F reading.
+    richer=(("resonance", "F"),),
 )
 # fmt: on

@@ -166,6 +166,11 @@ class EffectInfo:
     #: (``sim.effects._compose``). None for the nine of STAND.md §5, whose terms the
     #: kernel holds.
     weight_force: Any = None
+    #: How its form can be generalised: the remainder signature variants (kind, channel:
+    #: ``sim.identify.signature.VARIANTS``) that a richer form of it would add. A further
+    #: effect on top of this one is named only if it beats them (a second effect must not
+    #: be this one's form mismatch).
+    richer: tuple[tuple[str, str], ...] = ()
 
     def param(self, name: str) -> ParamInfo:
         """A parameter by name (EffectError if unknown)."""

@@ -40,5 +40,7 @@ INFO = EffectInfo(
               "rim displacement before the bearing slides (at rest load)", fit=False, log=True),
     ),
     check_stand=_check_stand,
+    # Richer forms: another bearing law, a compliant rim: speed shapes, a mode.
+    richer=(("velocity", "u+F"), ("resonance", "u+F")),
 )
 # fmt: on

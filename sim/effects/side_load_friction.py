@@ -21,5 +21,7 @@ INFO = EffectInfo(
               "μ_s, friction coefficient of the guide wall", bounds=(0.0, 0.8),
               why="steel or aluminium on a dry guide wall: up to 0.6–0.8"),
     ),
+    # Richer forms: another exponent of the tension, a speed dependence.
+    richer=(("strain", "u+F"), ("velocity", "u+F")),
 )
 # fmt: on

@@ -39,5 +39,7 @@ INFO = EffectInfo(
                   "that holds the weight still (Karnopp) is its stiff limit"),
     ),
     carried=True,
+    # Richer forms: another friction curve: speed shapes on the weight.
+    richer=(("velocity", "u+F"),),
 )
 # fmt: on

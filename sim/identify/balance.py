@@ -68,7 +68,7 @@ REST_S = (0.05, 0.4)
 #: The kinds and where they act, as ``signature.VARIANTS`` (``u+F``: a physical term).
 BALANCE_VARIANTS = (
     ("position", "u+F"), ("position", "u"), ("strain", "u+F"), ("velocity", "u+F"),
-    ("resonance", "u+F"), ("resonance", "F"), ("drift", "u"), ("drift", "F"),
+    ("velocity", "u"), ("resonance", "u+F"), ("resonance", "F"), ("drift", "u"), ("drift", "F"),
 )  # fmt: skip
 
 
@@ -226,6 +226,8 @@ class _BalanceLibrary:
             add(f"v·|v|/({vt})²", "N", "weight", b.v * np.abs(b.v) / self.v_top**2)
             for s in VELOCITY_SCALES_M_S:
                 add(f"tanh(v/{s:g} m/s)", "N", "weight", np.tanh(b.v / s))
+            for s in VELOCITY_SCALES_M_S:  # a gauge's backlash: the reading lags the motion
+                add(f"tanh(v/{s:g} m/s)", "m", "u", np.tanh(b.v / s))
         elif kind == "resonance":
             for hz in BALANCE_MODES_HZ:
                 for zeta in BALANCE_MODE_ZETAS:

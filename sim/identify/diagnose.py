@@ -332,23 +332,25 @@ def diagnose(
         alone = {e: _own_values(e, f.result.values) for e, f in refits.items()}
         # Further effects, one at a time on top of those named (``MAX_EFFECTS``), each
         # judged against the model before it and against a signature of its remainder.
-        while len(accepted) < MAX_EFFECTS:
+        set_aside: list[str] = []  # passed, but no better than a richer form
+        while len(accepted) + len(set_aside) < MAX_EFFECTS:  # each try: ~10 s of refits
             named = tuple(a.effect for a in accepted)
             further, further_sims = _further_effect(
-                named, current, trained, alone, base_fit.train_cost, pool, traces, nominal,
-                x_base, say,
+                named, current, trained, alone, base_fit.train_cost,
+                [e for e in pool if e not in set_aside], traces, nominal, x_base, say,
             )  # fmt: skip
             sims += further_sims
             if further is None:
                 break
             rival = signature_rival(
                 traces, current.outputs, nominal, current.result.values, further[1].outputs,
-                further=True,
+                named,
             )  # fmt: skip
-            if rival is not None:
+            if rival is not None:  # a form mismatch of those named: try the others
                 say(f"{further[0].effect} does no better than a {rival} term: not named")
                 displaced[further[0].effect] = rival
-                break
+                set_aside.append(further[0].effect)
+                continue
             accepted.append(further[0])
             current = further[1]
         timings["further_effects"] = time.perf_counter() - started
@@ -402,7 +404,7 @@ def signature_rival(
     nominal: StandParams,
     values: dict[str, float],
     effect: Sequence[Outputs],
-    further: bool = False,
+    named: Sequence[str] = (),
 ) -> str | None:
     """The kind of library term an effect does not beat on held-out cycles, or None.
 
@@ -414,25 +416,23 @@ def signature_rival(
     fitted a Maxwell branch with a gauge's gain as well as the branch did (X 23.8 against
     24.4) with a 100 N pulley eccentricity.
 
-    A ``further`` effect, on top of those named, must itself beat the best of the
-    library's terms fitted to the named model's remainder, whether they pass or not:
-    those terms are a richer form of the model it extends, and a further effect that
-    does no better only soaks up the named ones' form mismatch (a dial gauge's backlash
-    named as a channel's time skew).
+    A further effect, on top of those ``named``, must itself beat the richer forms the
+    named effects declare (``EffectInfo.richer``), fitted to their model's remainder,
+    whether those pass or not: a further effect that does no better only soaks up the
+    named ones' form mismatch (the other stand's dial gauge, with curvature and
+    backlash, had its backlash named as a time skew).
     """
     signatures, fits, _ = judge_signatures(traces, before, nominal, values)
-    # A further effect against the terms with a formula (``other``, the training cycles'
-    # mean, is no form of any model: it predicts whatever repeats).
-    pool = (
-        [s for s in signatures if s.kind != "other"]
-        if further
-        else [s for s in signatures if s.passes]
-    )
+    if named:
+        richer = {form for name in named for form in EFFECTS[name].richer}
+        pool = [s for s in signatures if (s.kind, s.channel) in richer]
+    else:
+        pool = [s for s in signatures if s.passes]
     if not pool:
         return None
     best = min(pool, key=lambda s: s.excess_after)
     name = f"{best.kind} in {best.channel}"
-    if further:
+    if named:
         return None if beats(traces, effect, fits[name].outputs) else name
     return name if beats(traces, fits[name].outputs, effect) else None
 

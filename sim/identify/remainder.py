@@ -157,10 +157,7 @@ def _passes(ev: Evidence, tests: int, source: str) -> bool:
     """
     if source == "outputs":
         return ev.accepted(tests, REMAINDER_ALPHA)
-    return (
-        ev.corrected_p(tests) <= REMAINDER_ALPHA
-        and ev.gain >= MIN_GAIN_OVER_NOISE * ev.x_before
-    )
+    return ev.corrected_p(tests) <= REMAINDER_ALPHA and ev.gain >= MIN_GAIN_OVER_NOISE * ev.x_before
 
 
 def _closes(ev: Evidence) -> float:

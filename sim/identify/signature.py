@@ -57,7 +57,7 @@ KINDS = ("position", "strain", "velocity", "resonance", "drift", "other")
 #: weight's bounces) kept a force gauge's real drift from passing.
 VARIANTS = (
     ("position", "u+F"), ("position", "u"), ("strain", "u+F"), ("velocity", "u+F"),
-    ("resonance", "u+F"), ("resonance", "F"), ("drift", "u"), ("drift", "F"),
+    ("velocity", "u"), ("resonance", "u+F"), ("resonance", "F"), ("drift", "u"), ("drift", "F"),
 )  # fmt: skip
 _ROUTES = {"u+F": {"weight", "tension"}, "u": {"u"}, "F": {"F"}}
 #: The baseline's own parameters as library terms (stiffness, damping, friction), in every
@@ -230,11 +230,12 @@ class _Library:
             ]  # fmt: skip
         if kind == "strain":  # the fibre's law beyond linear
             return [Term(kind, "tension", f"(T/{t})^{p}", "N") for p in (2, 3)]
-        if kind == "velocity":  # viscous, drag, Coulomb-like shapes
+        if kind == "velocity":  # viscous, drag, Coulomb-like shapes; a gauge's backlash
             return [
                 Term(kind, "weight", f"v/{v}", "N"),
                 Term(kind, "weight", f"v·|v|/({v})²", "N"),
                 *(Term(kind, "weight", f"tanh(v/{s:g} m/s)", "N") for s in VELOCITY_SCALES_M_S),
+                *(Term(kind, "u", f"tanh(v/{s:g} m/s)", "m") for s in VELOCITY_SCALES_M_S),
             ]
         if kind == "resonance":  # the tension through a damped mode, as a force or a reading
             return [
@@ -272,6 +273,7 @@ class _Library:
             rows += [(np.maximum(out.force_n, 0.0) / self.t_ref) ** p for p in (2, 3)]
         elif kind == "velocity":
             rows += [v / self.v_top, v * np.abs(v) / self.v_top**2]
+            rows += [np.tanh(v / s) for s in VELOCITY_SCALES_M_S]
             rows += [np.tanh(v / s) for s in VELOCITY_SCALES_M_S]
         elif kind == "resonance":
             for hz in RESONANCE_HZ:
