@@ -29,7 +29,6 @@ import numpy as np
 from sim.identify.balance import fit_balances
 from sim.identify.decide import (
     ALPHA,
-    MIN_GAIN_OVER_NOISE,
     Evidence,
     block_gains,
     family_p_values,
@@ -109,8 +108,10 @@ def judge_signatures(
     x_after = {n: heldout_excess(traces, fits[n].outputs) for n in names}
     before = dict.fromkeys(names, x_before)
     info = {n: (fits[n].kind, fits[n].channel, fits[n].formula, "outputs") for n in names}
+    resolution: dict[str, float] = {}
     if balances:
         for fit in fit_balances(traces, outputs, nominal, values):
+            resolution[fit.name] = fit.resolution
             names.append(fit.name)
             rows.append(np.log(np.maximum(fit.before, 1e-300) / np.maximum(fit.after, 1e-300)))
             before[fit.name] = float(np.sqrt(np.mean(fit.before)))
@@ -132,7 +133,7 @@ def judge_signatures(
                 closes=_closes(ev) if source == "outputs" else _removes(ev),
                 excess_after=ev.x_after,
                 p_family=ev.corrected_p(len(names)),
-                passes=_passes(ev, len(names), source),
+                passes=_passes(ev, len(names), resolution.get(name)),
                 source=source,
             )
         )
@@ -146,18 +147,19 @@ def judge_signatures(
     return signatures, fits, evidence
 
 
-def _passes(ev: Evidence, tests: int, source: str) -> bool:
+def _passes(ev: Evidence, tests: int, resolution: float | None) -> bool:
     """Evidence at the remainder's rate, and a gain that the noise's resolution allows.
 
-    The model's outputs: the effects' own rule (``Evidence.accepted``). The balances'
-    noise is their spread at rest, known to about a tenth like every noise here but
-    with no floor to measure a gap from (they can sit below 1 in motion), so their gain
-    must be a tenth of their error (``MIN_GAIN_OVER_NOISE``): a validation campaign with
-    no effect had a drift term pass at p 0.001 for removing 0.3 % of it.
+    The model's outputs (``resolution`` None): the effects' own rule
+    (``Evidence.accepted``). The balances have no floor to count a gap from (they can
+    sit below 1 in motion), so their gain must exceed how well their noise unit is known
+    (``balance.noise_resolution``, about 4 % with four recordings): a validation
+    campaign with no effect had a drift term pass at p 0.001 for removing 0.3 % of the
+    error, while a light weight's oiled guide removed 8.7 %.
     """
-    if source == "outputs":
+    if resolution is None:
         return ev.accepted(tests, REMAINDER_ALPHA)
-    return ev.corrected_p(tests) <= REMAINDER_ALPHA and ev.gain >= MIN_GAIN_OVER_NOISE * ev.x_before
+    return ev.corrected_p(tests) <= REMAINDER_ALPHA and ev.gain >= resolution * ev.x_before
 
 
 def _closes(ev: Evidence) -> float:
