@@ -426,8 +426,9 @@ def signature_rival(
     if named:
         richer = {form for name in named for form in EFFECTS[name].richer}
         pool = [s for s in signatures if (s.kind, s.channel) in richer]
-    else:
-        pool = [s for s in signatures if s.passes]
+    else:  # a rival with a formula: ``other`` repeats whatever repeats, every effect at
+        # once, and beat the one of three it was set against (a gauge low-pass)
+        pool = [s for s in signatures if s.passes and s.kind != "other"]
     if not pool:
         return None
     best = min(pool, key=lambda s: s.excess_after)
