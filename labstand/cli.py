@@ -21,6 +21,7 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any, NoReturn
 
 from drivers.limits import LimitError
+from labstand.commands.outputs import add_force, check_outputs
 from labstand.errors import CommandError, ExitCode
 from recordings.errors import RecordingError
 from sim.errors import SimulationError
@@ -104,6 +105,8 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
     for name in COMMANDS:
         if command is None or name == command:
             importlib.import_module(command_module(name)).register(sub)
+            if sub.choices[name].get_default("outputs"):
+                add_force(sub.choices[name])
         else:
             sub.add_parser(name, add_help=False)
     return parser
@@ -169,6 +172,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         format="%(levelname)s %(name)s: %(message)s",
     )
     try:
+        check_outputs(args, getattr(args, "outputs", None) or {})  # before any work
         code: int = args.func(args)
     except BrokenPipeError:
         # The reader went away (`labstand info X | head -1`): end quietly, as Unix tools

@@ -6,6 +6,8 @@ import argparse
 import json
 from pathlib import Path
 
+from labstand.commands.outputs import FILE
+
 
 def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Add ``labstand compare``."""
@@ -18,7 +20,7 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     parser.add_argument("b", type=Path, help="second recording")
     parser.add_argument("--json", action="store_true", help="print JSON (channels.u.R, ...)")
     parser.add_argument("--plot", type=Path, metavar="PNG", help="A vs B + difference")
-    parser.set_defaults(func=run)
+    parser.set_defaults(func=run, outputs={"plot": FILE})
 
 
 def run(args: argparse.Namespace) -> int:

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from labstand.commands.outputs import FILE
 from labstand.errors import CommandError, ExitCode
 
 
@@ -22,7 +23,7 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     )
     parser.add_argument("source", type=Path, metavar="A", help="recording to read")
     parser.add_argument("target", type=Path, metavar="B", help="recording to write")
-    parser.set_defaults(func=run)
+    parser.set_defaults(func=run, outputs={"target": FILE})
 
 
 def writable_suffixes() -> list[str]:

@@ -8,6 +8,7 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from labstand.commands.outputs import FOLDER
 from labstand.distributed import add_cluster_options
 from labstand.errors import CommandError, ExitCode
 
@@ -58,7 +59,7 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     )
     parser.add_argument("--json", action="store_true", help="print the result as JSON")
     parser.add_argument("--report", type=Path, metavar="DIR", help="write an HTML report here")
-    parser.set_defaults(func=run)
+    parser.set_defaults(func=run, outputs={"report": FOLDER, "results": FOLDER})
 
 
 def _mass_of(

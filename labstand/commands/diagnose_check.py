@@ -11,6 +11,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from labstand.commands.common import add_stand_options, load_stand
+from labstand.commands.outputs import FILE, FOLDER
 from labstand.distributed import (
     ClusterOptions,
     JobResult,
@@ -103,7 +104,7 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
         help="write the campaigns' table and the confusion matrix here",
     )
     add_cluster_options(parser)
-    parser.set_defaults(func=run)
+    parser.set_defaults(func=run, outputs={"output": FILE, "results": FOLDER})
 
 
 @dataclass(frozen=True)

@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import Any
 
 from labstand.commands.common import add_stand_options, config_with_mass, load_stand
+from labstand.commands.outputs import FILE
 from labstand.errors import CommandError, ExitCode
 
 MAP_HELP = """\
@@ -69,7 +70,7 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     parser.add_argument(
         "-o", "--output", type=Path, required=True, help="the recording (.mcap or .h5)"
     )
-    parser.set_defaults(func=run)
+    parser.set_defaults(func=run, outputs={"output": FILE})
 
 
 def run(args: argparse.Namespace) -> int:

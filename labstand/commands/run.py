@@ -26,6 +26,7 @@ from typing import TYPE_CHECKING, Any
 
 from drivers.signals import SignalSpec, plan_motion
 from labstand.commands.common import add_stand_options, config_with_mass, load_stand
+from labstand.commands.outputs import FILE
 from labstand.commands.simulate import add_signal_options, signal_from_args
 from labstand.errors import CommandError, ExitCode
 from labstand.live.address import ViewerAddress, parse_address
@@ -104,7 +105,7 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     )
     # for tests: faults injected by the simulated stand (sim/hardware/faults.py)
     parser.add_argument("--sim-fault", action="append", default=[], help=argparse.SUPPRESS)
-    parser.set_defaults(func=run)
+    parser.set_defaults(func=run, outputs={"output": FILE})
 
 
 def _title(args: argparse.Namespace, spec: SignalSpec, mass_kg: float) -> str:
@@ -176,8 +177,6 @@ def _check(args: argparse.Namespace) -> _Plan:
             f"{', '.join(writable)}",
             ExitCode.USAGE,
         )
-    if not args.output.parent.is_dir():
-        raise CommandError(f"{args.output.parent}: no such directory", ExitCode.USAGE)
     confirm = backend == "stand" and not args.yes
     if confirm and not sys.stdin.isatty():
         raise CommandError(

@@ -14,6 +14,7 @@ import numpy as np
 # Light (numpy only): the parser's choices. The model (numba, scipy) is imported in run().
 from drivers.signals import DriveProfile, Shape, SignalSpec, plan_motion
 from labstand.commands.common import add_stand_options, load_stand
+from labstand.commands.outputs import FILE
 from labstand.errors import CommandError, ExitCode
 from sim.situations import SITUATIONS, situation
 
@@ -98,7 +99,7 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
         "--noise", action="store_true", help="add realistic gauge noise, mains hum, quantisation"
     )
     effects.add_argument("--seed", type=int, default=0, help="seed of --noise (default 0)")
-    parser.set_defaults(func=run)
+    parser.set_defaults(func=run, outputs={"output": FILE, "plot": FILE})
 
 
 def summarise(result: SimResult, profile: DriveProfile, mass_kg: float) -> dict[str, Any]:

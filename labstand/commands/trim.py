@@ -7,6 +7,7 @@ from pathlib import Path
 
 from labstand.commands.cat import add_window_options
 from labstand.commands.convert import check_target
+from labstand.commands.outputs import FILE
 from labstand.errors import CommandError, ExitCode
 
 
@@ -22,7 +23,7 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     )
     add_window_options(parser)
     parser.add_argument("-o", "--output", type=Path, required=True, help="the new recording")
-    parser.set_defaults(func=run)
+    parser.set_defaults(func=run, outputs={"output": FILE})
 
 
 def run(args: argparse.Namespace) -> int:
