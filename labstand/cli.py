@@ -21,8 +21,8 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any, NoReturn
 
 from drivers.limits import LimitError
-from labstand.commands.outputs import add_force, check_outputs
 from labstand.errors import CommandError, ExitCode
+from labstand.targets import add_force, check_outputs
 from recordings.errors import RecordingError
 from sim.errors import SimulationError
 

@@ -6,7 +6,7 @@ import argparse
 import json
 from pathlib import Path
 
-from labstand.commands.outputs import FILE
+from labstand.targets import FILE
 
 
 def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:

@@ -5,8 +5,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from labstand.commands.outputs import FILE
 from labstand.errors import CommandError, ExitCode
+from labstand.targets import FILE
 
 
 def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:

@@ -8,9 +8,9 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from labstand.commands.outputs import FOLDER
 from labstand.distributed import add_cluster_options
 from labstand.errors import CommandError, ExitCode
+from labstand.targets import FOLDER
 
 if TYPE_CHECKING:  # imported where they run: `diagnose --help` loads no numba or pandas
     from sim.config import StandConfig

@@ -11,7 +11,6 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from labstand.commands.common import add_stand_options, load_stand
-from labstand.commands.outputs import FILE, FOLDER
 from labstand.distributed import (
     ClusterOptions,
     JobResult,
@@ -22,6 +21,7 @@ from labstand.distributed import (
     say_failures,
 )
 from labstand.errors import CommandError, ExitCode
+from labstand.targets import FILE, FOLDER
 
 if TYPE_CHECKING:  # imported where they run: `diagnose-check --help` loads no numba
     from drivers.signals import SignalSpec

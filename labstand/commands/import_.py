@@ -8,8 +8,8 @@ from pathlib import Path
 from typing import Any
 
 from labstand.commands.common import add_stand_options, config_with_mass, load_stand
-from labstand.commands.outputs import FILE
 from labstand.errors import CommandError, ExitCode
+from labstand.targets import FILE
 
 MAP_HELP = """\
 which column holds which quantity: FIELD=COLUMN or FIELD=COLUMN[UNIT], repeatable.

@@ -9,8 +9,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from labstand.commands.outputs import FILE, check_output
 from labstand.distributed import add_cluster_options, run_many
+from labstand.targets import FILE, check_output
 
 if TYPE_CHECKING:  # imported where they run: `replay --help` loads no numba or pandas
     from sim.metrics import ChannelMetrics

@@ -26,7 +26,6 @@ from typing import TYPE_CHECKING, Any
 
 from drivers.signals import SignalSpec, plan_motion
 from labstand.commands.common import add_stand_options, config_with_mass, load_stand
-from labstand.commands.outputs import FILE
 from labstand.commands.simulate import add_signal_options, signal_from_args
 from labstand.errors import CommandError, ExitCode
 from labstand.live.address import ViewerAddress, parse_address
@@ -41,6 +40,7 @@ from labstand.session import (
 from labstand.session.display import make_display
 from labstand.session.record import RecordingPipe
 from labstand.session.safety import EStopError, SafetyLimits
+from labstand.targets import FILE
 from recordings.base import open_writer
 from recordings.schema import Effect, RecordingMetadata, make_metadata
 

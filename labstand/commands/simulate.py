@@ -14,8 +14,8 @@ import numpy as np
 # Light (numpy only): the parser's choices. The model (numba, scipy) is imported in run().
 from drivers.signals import DriveProfile, Shape, SignalSpec, plan_motion
 from labstand.commands.common import add_stand_options, load_stand
-from labstand.commands.outputs import FILE
 from labstand.errors import CommandError, ExitCode
+from labstand.targets import FILE
 from sim.situations import SITUATIONS, situation
 
 if TYPE_CHECKING:

@@ -7,8 +7,8 @@ from pathlib import Path
 
 from labstand.commands.cat import add_window_options
 from labstand.commands.convert import check_target
-from labstand.commands.outputs import FILE
 from labstand.errors import CommandError, ExitCode
+from labstand.targets import FILE
 
 
 def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
