@@ -24,7 +24,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from labstand.errors import CommandError, ExitCode
+from labstand.errors import CommandError, ExitCode, describe_os_error
 from recordings import open_recording
 from sim.config import load_config
 from sim.identify import DiagnosisInputError, Trace, diagnose, make_trace
@@ -48,9 +48,8 @@ def load_manifest(path: Path) -> list[Campaign]:
     try:
         data = tomllib.loads(path.read_text())
     except OSError as err:
-        raise CommandError(
-            f"{path}: cannot read the manifest: {err.strerror}", ExitCode.USAGE
-        ) from None
+        text, _ = describe_os_error(err)  # "no such file: X", "X: is a folder, not a file"
+        raise CommandError(f"cannot read the manifest: {text}", ExitCode.USAGE) from None
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as err:
         raise CommandError(f"{path}: not TOML: {err}", ExitCode.USAGE) from None
     tables = data.get("campaign")

@@ -21,7 +21,7 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any, NoReturn
 
 from drivers.limits import LimitError
-from labstand.errors import CommandError, ExitCode
+from labstand.errors import CommandError, ExitCode, describe_os_error
 from labstand.targets import add_force, check_outputs
 from recordings.errors import RecordingError
 from sim.errors import SimulationError
@@ -129,15 +129,22 @@ _PREFIXES = {
 }
 
 
-def _error_code(err: Exception) -> ExitCode:
+def describe(err: Exception) -> tuple[str, ExitCode]:
+    """The one place an exception becomes the user's line and the exit code."""
     if isinstance(err, CommandError):
-        return err.code
-    if isinstance(err, LimitError):
-        return ExitCode.REFUSED
+        code = err.code
+    elif isinstance(err, LimitError):
+        code = ExitCode.REFUSED
+    elif isinstance(err, OSError):
+        text, code = describe_os_error(err)
+        return f"labstand: {_PREFIXES.get(code, 'error')}: {text}", code
     # ConfigError (sim.config, not imported here: it pulls scipy) is a ValueError too.
-    if isinstance(err, SimulationError | RecordingError | ValueError):
-        return ExitCode.USAGE
-    return ExitCode.FAILURE
+    elif isinstance(err, SimulationError | RecordingError | ValueError):
+        code = ExitCode.USAGE
+    else:
+        code = ExitCode.FAILURE
+    text = " ".join(str(err).split()) or type(err).__name__  # one line, whatever it holds
+    return f"labstand: {_PREFIXES.get(code, 'error')}: {text}", code
 
 
 def _subparser(parser: argparse.ArgumentParser, name: str | None) -> argparse.ArgumentParser | None:
@@ -193,9 +200,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     ) as err:
         if args.verbose:
             log.exception("command failed")
-        code = _error_code(err)
-        prefix = _PREFIXES.get(code, "error")
-        print(f"labstand: {prefix}: {err}", file=sys.stderr)
+        line, code = describe(err)
+        print(line, file=sys.stderr)
         return code
     return code
 

@@ -8,7 +8,7 @@ from pathlib import Path
 from typing import Any
 
 from labstand.commands.common import add_stand_options, config_with_mass, load_stand
-from labstand.errors import CommandError, ExitCode
+from labstand.errors import CommandError, ExitCode, require_file
 from labstand.targets import FILE
 
 MAP_HELP = """\
@@ -80,6 +80,7 @@ def run(args: argparse.Namespace) -> int:
     from recordings.foreign import parse_mapping
     from recordings.tdmsio import read_tdms
 
+    require_file(args.file)  # before its suffix: "no such file" says more
     suffix = args.file.suffix.lower()
     if suffix not in {".csv", ".tdms"}:
         raise CommandError(

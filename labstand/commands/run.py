@@ -13,6 +13,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import logging
+import math
 import os
 import signal
 import sys
@@ -146,6 +147,8 @@ def _check(args: argparse.Namespace) -> _Plan:
 
     config = load_stand(args)
     spec, mass = signal_from_args(args, config)
+    if not (math.isfinite(mass) and mass > 0):  # before the simulated stand starts with it
+        raise CommandError(f"--mass-kg: mass must be > 0 kg, got {mass:g} kg", ExitCode.USAGE)
     from labstand.session.devices import BACKENDS, default_backend
 
     backend = args.backend or default_backend(config)

@@ -57,7 +57,7 @@ def test_campaigns_refuse_what_the_manifest_says_and_a_missing_file(
 ) -> None:
     missing = tmp_path / "none.toml"
     assert main(["diagnose", "--campaigns", str(missing)]) == 2
-    assert f"{missing}: cannot read the manifest" in capsys.readouterr().err
+    assert f"cannot read the manifest: no such file: {missing}" in capsys.readouterr().err
     assert main(["diagnose", "x.csv", "--campaigns", str(missing)]) == 2
     assert "--campaigns takes the recordings" in capsys.readouterr().err
     assert main(["diagnose"]) == 2
