@@ -35,7 +35,8 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
         type=Path,
         metavar="FILE",
         help="diagnose every campaign of a TOML manifest ([campaign.NAME] tables with "
-        "recordings, mass_kg, optional stand and truth), in parallel on Dask",
+        "recordings, optional mass_kg (default: each recording's stored weight), stand and "
+        "truth), in parallel on Dask",
     )
     parser.add_argument(
         "--results",
@@ -70,16 +71,9 @@ def _mass_of(
         return override, "--mass-kg"
     if stand is not None:
         return stand.default_mass_kg, f"default weight of {stand.source}"
-    try:
-        from sim.config import config_from_dict
+    from labstand.campaigns import stored_mass
 
-        mass = config_from_dict(stored, str(path)).default_mass_kg  # type: ignore[arg-type]
-    except (ValueError, TypeError):  # sim.config.ConfigError is a ValueError
-        from sim.config import load_config
-
-        fallback = load_config(None).default_mass_kg
-        return fallback, "the paper stand's default weight (the stored stand is unreadable)"
-    return mass, "stored in the recording"
+    return stored_mass(path, stored)
 
 
 def run(args: argparse.Namespace) -> int:

@@ -146,7 +146,7 @@ def run(args: argparse.Namespace) -> int:
     summary["situation"] = args.situation
     summary["wall_s"] = elapsed
     if args.output is not None:
-        write_simulation(args.output, result, config, args.params, profile, args.situation)
+        write_simulation(args.output, result, config, args.params, profile, args.situation, mass)
         summary["output"] = str(args.output)
     if args.plot is not None:
         from labstand.plots import plot_run

@@ -35,7 +35,7 @@ def test_paths_are_relative_to_the_manifest(tmp_path: Path) -> None:
         ("title = 'x'\n", "m.toml: no [campaign.NAME] tables"),
         ("[campaign.a]\nrecordings = []\nmass_kg = 3\n",
          "[campaign.a]: recordings must be a non-empty list of paths"),
-        (f"{A}\n", "[campaign.a]: mass_kg must be a number > 0, got None"),
+        (f"{A}mass_kg = 'heavy'\n", "[campaign.a]: mass_kg must be a number > 0, got 'heavy'"),
         (f"{A}mass_kg = -3\n", "mass_kg must be a number > 0, got -3"),
         (f"{A}mass_kg = 3\nmass = 4\n",
          "[campaign.a]: unknown key(s) mass (known: mass_kg, recordings, stand, truth)"),
