@@ -39,6 +39,7 @@ COMMANDS: dict[str, str] = {
     "compare": "compare two recordings (e.g. two runs of one situation)",
     "table1": "Table 1 of the paper: R per channel for two parameter sets",
     "info": "duration, channels, rates, lost samples and metadata of a recording",
+    "ls": "list the recordings of a folder (date, duration, signal, mass, operator, sample)",
     "import": "import a CSV or TDMS run as a recording",
     "convert": "convert a recording into MCAP, HDF5, CSV or Parquet",
     "cat": "print samples or events of a time window as CSV text",

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -25,6 +26,7 @@ def write_simulation(
     profile: DriveProfile,
     situation: str | None,
     mass_kg: float | None = None,
+    **extra: Any,
 ) -> None:
     """Write a simulated run; the suffix picks the format.
 
@@ -61,8 +63,9 @@ def write_simulation(
         stand,  # its default weight is the simulated one, as `run` stores it
         Backend.SIMULATE,
         sample_rate_hz=rate,
-        signal=profile.spec.to_dict(),
+        signal={**profile.spec.to_dict(), "situation": situation},
         operator_note=f"labstand simulate: {what}, parameter set {params!r}",
+        **extra,  # operator, sample, tags
     )
     end_ns = int(gauges["t_ns"][-1])
     events = [(0, "start", what), (end_ns, "stop", "end of simulation")]

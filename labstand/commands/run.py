@@ -26,7 +26,13 @@ from types import FrameType
 from typing import TYPE_CHECKING, Any
 
 from drivers.signals import SignalSpec, plan_motion
-from labstand.commands.common import add_stand_options, config_with_mass, load_stand
+from labstand.commands.common import (
+    add_metadata_options,
+    add_stand_options,
+    config_with_mass,
+    load_stand,
+    metadata_options,
+)
 from labstand.commands.simulate import add_signal_options, signal_from_args
 from labstand.errors import CommandError, ExitCode
 from labstand.live.address import ViewerAddress, parse_address
@@ -72,6 +78,7 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     )
     parser.add_argument("-o", "--output", type=Path, required=True, help="recording (.mcap, .h5)")
     parser.add_argument("--note", default="", help="operator note, stored in the recording")
+    add_metadata_options(parser)
     parser.add_argument("--yes", action="store_true", help="start without asking (stand)")
     parser.add_argument(
         "--reset-trip", action="store_true", help="reset a tripped drive during pre-flight"
@@ -276,6 +283,7 @@ def _session(
             signal={**plan.spec.to_dict(), "situation": args.situation},
             effects=tuple(Effect(e.name, e.resolved()) for e in plan.effects),
             operator_note=args.note,
+            **metadata_options(args),
         )
         return _record(session, devices, metadata, args, stop, title, live)
 

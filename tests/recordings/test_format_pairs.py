@@ -42,7 +42,8 @@ def made(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
     """The run (MCAP) and its conversion into every format (the A of each pair)."""
     folder = tmp_path_factory.mktemp("pairs")
     run = folder / "run.mcap"
-    done = labstand_process("run", *SHORT, "--note", "pairs", "-o", run)
+    who = ["--operator", "ana", "--sample", "F-07", "--tag", "warm", "--tag", "x"]
+    done = labstand_process("run", *SHORT, "--note", "pairs", *who, "-o", run)
     assert done.code == 0, done.err
     out = {".mcap": run}
     for suffix in FORMATS[1:]:
@@ -74,6 +75,9 @@ def test_a_pair_reads_back(made: dict[str, Path], tmp_path: Path, a: str, b: str
     assert got.events_array.tolist() == want.events_array.tolist()
     np.testing.assert_array_equal(got.command_on_gauge_clock(), want.command_on_gauge_clock())
     assert got.metadata.to_dict() == want.metadata.to_dict()
+    meta = got.metadata  # the run's structured metadata, in every format
+    assert (meta.operator, meta.sample, meta.tags) == ("ana", "F-07", ("warm", "x"))
+    assert len(meta.run_id) == 36
     assert _info(target) == _info(source, said)
     assert labstand("cat", target) == said("cat", source)
     assert labstand("cat", target, "--events") == said("cat", source, "--events")
