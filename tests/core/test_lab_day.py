@@ -33,7 +33,8 @@ def labstand(*args: str | Path) -> subprocess.CompletedProcess[str]:
 @pytest.fixture(scope="module")
 def run_rec(tmp_path_factory: pytest.TempPathFactory) -> Path:
     out = tmp_path_factory.mktemp("run") / "run.mcap"
-    done = labstand_process("run", *SHORT, "--note", "lab day", "-o", out)
+    effect = ["--effect", "fibre_viscoelastic:relaxation_time_s=0.02", "--mass-kg", "3.096"]
+    done = labstand_process("run", *SHORT, *effect, "--note", "lab day", "-o", out)
     assert done.code == 0, done.err
     return out
 
@@ -121,3 +122,24 @@ def test_diagnosis_takes_exactly_one_second(run_rec: Path, tmp_path: Path) -> No
     with pytest.raises(DiagnosisInputError) as info:
         trace_of("short.h5", open_recording(short).frame(), 8.131)
     assert str(info.value) == "short.h5: spans 0.9995 s; the fit needs at least 1 s"
+
+
+def test_info_shows_mass_situation_and_effects(run_rec: Path, tmp_path: Path) -> None:
+    text = labstand("info", run_rec).stdout
+    assert "\n  mass 3.096 kg\n" in text
+    assert "simulated effect fibre_viscoelastic: branch_stiffness_n_m = 20000, " in text
+    assert "relaxation_time_s = 0.02\n" in text
+    s10 = tmp_path / "s10.h5"
+    assert labstand("simulate", "--situation", "10", "-o", s10).returncode == 0
+    assert "  signal situation 10: " in labstand("info", s10).stdout
+
+
+def test_compare_warns_when_signal_or_mass_differ(run_rec: Path, tmp_path: Path) -> None:
+    other = tmp_path / "s11.mcap"
+    assert labstand("simulate", "--situation", "11", "-o", other).returncode == 0
+    done = labstand("compare", run_rec, other)
+    assert done.returncode == 0, done.stderr
+    assert "  warning: the drive signals differ (amplitude_mm 20.0 vs 25.0" in done.stdout
+    assert "  warning: the masses differ (3.096 kg vs 8.131 kg)" in done.stdout
+    same = labstand("compare", run_rec, run_rec)
+    assert "warning" not in same.stdout
