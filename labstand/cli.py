@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING, Any, NoReturn
 
 from drivers.limits import LimitError
 from labstand.errors import CommandError, ExitCode, describe_os_error
+from labstand.stands import find_stand
 from labstand.targets import add_force, check_outputs
 from recordings.errors import RecordingError
 from sim.errors import SimulationError
@@ -180,6 +181,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         format="%(levelname)s %(name)s: %(message)s",
     )
     try:
+        if getattr(args, "find_stand", False) and args.stand is None:
+            args.stand, args.stand_origin = find_stand()
         check_outputs(args, getattr(args, "outputs", None) or {})  # before any work
         code: int = args.func(args)
     except BrokenPipeError:

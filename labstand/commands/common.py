@@ -13,8 +13,13 @@ if TYPE_CHECKING:
 def add_stand_options(parser: argparse.ArgumentParser, params: bool = False) -> None:
     """--stand FILE (and --params NAME)."""
     parser.add_argument(
-        "--stand", type=Path, metavar="FILE", help="stand configuration (default: the paper's)"
+        "--stand",
+        type=Path,
+        metavar="FILE",
+        help="stand configuration (default: $LABSTAND_STAND, else ./labstand.toml, else the "
+        "paper's stand)",
     )
+    parser.set_defaults(find_stand=True)  # labstand.cli fills --stand in (labstand.stands)
     if params:
         parser.add_argument(
             "--params",

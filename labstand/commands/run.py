@@ -231,6 +231,8 @@ def _run_devices(args: argparse.Namespace, plan: _Plan, live: LiveView | None) -
         title = _title(args, plan.spec, plan.mass_kg)
         _say(f"labstand run: {title}")
         _say(f"  {plan.backend}: {devices.where}")
+        if getattr(args, "stand_origin", ""):
+            _say(f"  stand file: {args.stand} (from {args.stand_origin})")
         display = make_display(sys.stdout)
         if live is not None:
             display = live.display(display)
