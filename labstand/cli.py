@@ -46,6 +46,7 @@ COMMANDS: dict[str, str] = {
     "cat": "print samples or events of a time window as CSV text",
     "trim": "cut a time window out of a recording into a new one",
     "recover": "recover a recording whose writer was killed",
+    "doctor": "check a recording and say what recover would do (writes nothing)",
     "diagnose": "find which unmodelled effect explains the gap between model and recordings",
     "diagnose-check": "score the diagnosis on generated recordings whose effect is withheld",
 }
@@ -101,7 +102,9 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
         prog="labstand",
         description="Run the fibre stand, record it, and compare it with the model.",
     )
-    parser.add_argument("--version", action=_Version, nargs=0, help="show the version and exit")
+    parser.add_argument(
+        "-V", "--version", action=_Version, nargs=0, help="show the version and exit"
+    )
     parser.add_argument("-v", "--verbose", action="store_true", help="log details to stderr")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True, action=_Commands)
     for name in COMMANDS:
