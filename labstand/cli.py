@@ -45,6 +45,7 @@ COMMANDS: dict[str, str] = {
     "convert": "convert a recording into MCAP, HDF5, CSV or Parquet",
     "cat": "print samples or events of a time window as CSV text",
     "trim": "cut a time window out of a recording into a new one",
+    "plot": "a quick look at a recording: x, u and F over time as a PNG",
     "recover": "recover a recording whose writer was killed",
     "doctor": "check a recording and say what recover would do (writes nothing)",
     "diagnose": "find which unmodelled effect explains the gap between model and recordings",
