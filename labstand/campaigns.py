@@ -104,7 +104,7 @@ def trace_of(name: str, frame: pd.DataFrame, mass_kg: float) -> Trace:
     span_s = (int(t_ns[-1]) - int(t_ns[0])) / 1e9 if len(t_ns) else 0.0
     if span_s < MIN_DURATION_S:
         raise DiagnosisInputError(
-            f"{name}: spans {span_s:.4g} s; the fit needs at least {MIN_DURATION_S:g} s"
+            f"{name}: spans {span_s:.4g} s, too short to fit (need ≥ {MIN_DURATION_S:g} s)"
         )
     return make_trace(
         name,

@@ -121,7 +121,7 @@ def test_diagnosis_takes_exactly_one_second(run_rec: Path, tmp_path: Path) -> No
     assert trace.mass_kg == 8.131
     with pytest.raises(DiagnosisInputError) as info:
         trace_of("short.h5", open_recording(short).frame(), 8.131)
-    assert str(info.value) == "short.h5: spans 0.9995 s; the fit needs at least 1 s"
+    assert str(info.value) == "short.h5: spans 0.9995 s, too short to fit (need ≥ 1 s)"
 
 
 def test_info_shows_mass_situation_and_effects(run_rec: Path, tmp_path: Path) -> None:
