@@ -6,7 +6,10 @@ import argparse
 from pathlib import Path
 
 from labstand.commands.cat import add_window_options
+from labstand.errors import CommandError, ExitCode
 from labstand.targets import FILE, check_output
+
+SUFFIXES = (".png", ".svg", ".pdf")
 
 
 def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -29,6 +32,12 @@ def run(args: argparse.Namespace) -> int:
     from recordings.window import read_window
 
     out: Path = args.output or args.recording.with_suffix(".png")
+    if out.suffix.lower() not in SUFFIXES:
+        raise CommandError(
+            f"{out}: cannot draw {out.suffix or 'files without a suffix'!r}; use one of "
+            f"{', '.join(SUFFIXES)}",
+            ExitCode.USAGE,
+        )
     if args.output is None:  # the default name is checked here, as -o is by the CLI
         check_output(out, args.force)
     window = read_window(args.recording, args.start, args.end)
