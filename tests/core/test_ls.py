@@ -91,3 +91,11 @@ def test_a_missing_path_is_one_line_and_exit_2(tmp_path: Path) -> None:
         done.returncode == 2
         and done.stderr == f"labstand: error: no such file: {tmp_path / 'nope'}\n"
     )
+
+
+def test_import_stores_the_operator_and_tags(folder: Path, tmp_path: Path) -> None:
+    out = tmp_path / "imported.h5"
+    argv = ["import", str(folder / "b.csv"), "--operator", "zoe", "--tag", "imported"]
+    assert main([*argv, "-o", str(out)]) == 0
+    (row,) = json.loads(ls(out, "--json").stdout)
+    assert (row["operator"], row["sample"], row["tags"]) == ("zoe", "F-07", ["imported"])
