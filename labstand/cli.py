@@ -212,6 +212,16 @@ def main(argv: Sequence[str] | None = None) -> int:
         line, code = describe(err)
         print(line, file=sys.stderr)
         return code
+    except Exception as err:  # a bug of ours: still one line; -v has the traceback
+        if args.verbose:
+            log.exception("command failed")
+        what = " ".join(str(err).split())
+        print(
+            f"labstand: error: internal error ({type(err).__name__}: {what}); "
+            "-v shows where, please report it",
+            file=sys.stderr,
+        )
+        return ExitCode.FAILURE
     return code
 
 

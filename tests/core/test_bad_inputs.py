@@ -122,3 +122,20 @@ def test_bad_input(places: dict[str, Path], words: str, code: int, says: str) ->
     assert "Traceback" not in line and "[Errno" not in line, line
     assert not re.search(r"0x[0-9a-f]{6,}|<\w+(\.\w+)* (at|object) ", line), line  # no library repr
     assert not places["OUT"].exists() and not list(places["OUT"].parent.glob("*.part*"))
+
+
+def test_an_unexpected_error_is_still_one_line(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import labstand.commands.info as info
+    from labstand.cli import main
+
+    def broken(args: object) -> int:
+        raise KeyError("bug")
+
+    monkeypatch.setattr(info, "run", broken)
+    assert main(["info", "x.mcap"]) == ExitCode.FAILURE
+    err = capsys.readouterr().err
+    assert err == (
+        "labstand: error: internal error (KeyError: 'bug'); -v shows where, please report it\n"
+    )
