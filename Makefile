@@ -23,10 +23,10 @@ $(STAMP): pyproject.toml requirements.lock
 DEMO_EFFECT := fibre_viscoelastic
 demo: $(STAMP)
 	@mkdir -p $(OUT)
-	$(BIN)/labstand run --backend sim --effect $(DEMO_EFFECT) --situation 11 --note "make demo" -o $(OUT)/run-11.mcap
-	$(BIN)/labstand run --backend sim --effect $(DEMO_EFFECT) --situation 10 --note "make demo" -o $(OUT)/run-10.mcap
-	$(BIN)/labstand replay $(OUT)/run-11.mcap --plot $(OUT)/replay-11.png
-	$(BIN)/labstand diagnose $(OUT)/run-11.mcap $(OUT)/run-10.mcap --report $(OUT)/diagnosis
+	$(BIN)/labstand run --backend sim --effect $(DEMO_EFFECT) --situation 11 --note "make demo" --force -o $(OUT)/run-11.mcap
+	$(BIN)/labstand run --backend sim --effect $(DEMO_EFFECT) --situation 10 --note "make demo" --force -o $(OUT)/run-10.mcap
+	$(BIN)/labstand replay $(OUT)/run-11.mcap --plot $(OUT)/replay-11.png --force
+	$(BIN)/labstand diagnose $(OUT)/run-11.mcap $(OUT)/run-10.mcap --report $(OUT)/diagnosis --force
 
 # Debian tools the tests use as independent peers; installed here, never assumed.
 system-tools:

@@ -126,7 +126,8 @@ class UnidriveSP(DriveInterface):
         self.name = name
         self._cw = ControlBit.AUTO.mask  # the control word as last written
         if not client.connect():
-            raise DriveConnectionError(f"{name}: cannot connect ({client!r})")
+            # the client's repr is pymodbus's, not the user's words: the name holds the address
+            raise DriveConnectionError(f"{name}: cannot connect (no answer at that address)")
 
     def _check_open(self) -> None:
         if self._closed:

@@ -76,7 +76,7 @@ def write_results(
 ) -> list[Path]:
     """Write the table and the confusion matrix into ``folder``; returns the files."""
     try:
-        folder.mkdir(parents=True, exist_ok=True)
+        folder.mkdir(exist_ok=True)  # its parent was checked before the work
         frame = pd.DataFrame(list(rows), columns=COLUMNS)
         if importlib.util.find_spec("pyarrow") is not None:
             table = folder / "campaigns.parquet"

@@ -21,7 +21,9 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any, NoReturn
 
 from drivers.limits import LimitError
-from labstand.errors import CommandError, ExitCode
+from labstand.errors import CommandError, ExitCode, describe_os_error
+from labstand.stands import find_stand
+from labstand.targets import add_force, check_outputs
 from recordings.errors import RecordingError
 from sim.errors import SimulationError
 
@@ -38,13 +40,17 @@ COMMANDS: dict[str, str] = {
     "compare": "compare two recordings (e.g. two runs of one situation)",
     "table1": "Table 1 of the paper: R per channel for two parameter sets",
     "info": "duration, channels, rates, lost samples and metadata of a recording",
+    "ls": "list the recordings of a folder (date, duration, signal, mass, operator, sample)",
     "import": "import a CSV or TDMS run as a recording",
     "convert": "convert a recording into MCAP, HDF5, CSV or Parquet",
     "cat": "print samples or events of a time window as CSV text",
     "trim": "cut a time window out of a recording into a new one",
+    "plot": "a quick look at a recording: x, u and F over time as a PNG",
     "recover": "recover a recording whose writer was killed",
+    "doctor": "check a recording and say what recover would do (writes nothing)",
     "diagnose": "find which unmodelled effect explains the gap between model and recordings",
     "diagnose-check": "score the diagnosis on generated recordings whose effect is withheld",
+    "completion": "print a shell completion script (bash, zsh, tcsh)",
 }
 
 log = logging.getLogger("labstand")
@@ -98,12 +104,16 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
         prog="labstand",
         description="Run the fibre stand, record it, and compare it with the model.",
     )
-    parser.add_argument("--version", action=_Version, nargs=0, help="show the version and exit")
+    parser.add_argument(
+        "-V", "--version", action=_Version, nargs=0, help="show the version and exit"
+    )
     parser.add_argument("-v", "--verbose", action="store_true", help="log details to stderr")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True, action=_Commands)
     for name in COMMANDS:
         if command is None or name == command:
             importlib.import_module(command_module(name)).register(sub)
+            if sub.choices[name].get_default("outputs"):
+                add_force(sub.choices[name])
         else:
             sub.add_parser(name, add_help=False)
     return parser
@@ -126,15 +136,22 @@ _PREFIXES = {
 }
 
 
-def _error_code(err: Exception) -> ExitCode:
+def describe(err: Exception) -> tuple[str, ExitCode]:
+    """The one place an exception becomes the user's line and the exit code."""
     if isinstance(err, CommandError):
-        return err.code
-    if isinstance(err, LimitError):
-        return ExitCode.REFUSED
+        code = err.code
+    elif isinstance(err, LimitError):
+        code = ExitCode.REFUSED
+    elif isinstance(err, OSError):
+        text, code = describe_os_error(err)
+        return f"labstand: {_PREFIXES.get(code, 'error')}: {text}", code
     # ConfigError (sim.config, not imported here: it pulls scipy) is a ValueError too.
-    if isinstance(err, SimulationError | RecordingError | ValueError):
-        return ExitCode.USAGE
-    return ExitCode.FAILURE
+    elif isinstance(err, SimulationError | RecordingError | ValueError):
+        code = ExitCode.USAGE
+    else:
+        code = ExitCode.FAILURE
+    text = " ".join(str(err).split()) or type(err).__name__  # one line, whatever it holds
+    return f"labstand: {_PREFIXES.get(code, 'error')}: {text}", code
 
 
 def _subparser(parser: argparse.ArgumentParser, name: str | None) -> argparse.ArgumentParser | None:
@@ -169,6 +186,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         format="%(levelname)s %(name)s: %(message)s",
     )
     try:
+        if getattr(args, "find_stand", False) and args.stand is None:
+            args.stand, args.stand_origin = find_stand()
+        check_outputs(args, getattr(args, "outputs", None) or {})  # before any work
         code: int = args.func(args)
     except BrokenPipeError:
         # The reader went away (`labstand info X | head -1`): end quietly, as Unix tools
@@ -189,10 +209,19 @@ def main(argv: Sequence[str] | None = None) -> int:
     ) as err:
         if args.verbose:
             log.exception("command failed")
-        code = _error_code(err)
-        prefix = _PREFIXES.get(code, "error")
-        print(f"labstand: {prefix}: {err}", file=sys.stderr)
+        line, code = describe(err)
+        print(line, file=sys.stderr)
         return code
+    except Exception as err:  # a bug of ours: still one line; -v has the traceback
+        if args.verbose:
+            log.exception("command failed")
+        what = " ".join(str(err).split())
+        print(
+            f"labstand: error: internal error ({type(err).__name__}: {what}); "
+            "-v shows where, please report it",
+            file=sys.stderr,
+        )
+        return ExitCode.FAILURE
     return code
 
 

@@ -249,7 +249,7 @@ def _fmt(value: object, key: object = None) -> str:
 
 def write_report(directory: Path, traces: Sequence[Trace], result: Diagnosis) -> Path:
     """Write index.html, its PNGs and result.json into directory; returns index.html."""
-    directory.mkdir(parents=True, exist_ok=True)
+    directory.mkdir(exist_ok=True)  # its parent was checked before the work
     _residual_plot(directory / "residual.png", traces, result)
     _ranking_plot(directory / "ranking.png", result)
     _overlay_plot(directory / "overlay.png", traces, result)

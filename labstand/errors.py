@@ -6,7 +6,9 @@ code, never as a traceback.
 
 from __future__ import annotations
 
+import errno
 from enum import IntEnum
+from pathlib import Path
 
 
 class ExitCode(IntEnum):
@@ -26,3 +28,35 @@ class CommandError(Exception):
     def __init__(self, message: str, code: ExitCode = ExitCode.FAILURE) -> None:
         super().__init__(message)
         self.code = code
+
+
+#: OS errors on an input, in words (the errno text, ``[Errno 2] ...``, is Python's).
+_OS_WORDS: dict[type[OSError], tuple[str, ExitCode]] = {
+    FileNotFoundError: ("no such file", ExitCode.USAGE),
+    IsADirectoryError: ("is a folder, not a file", ExitCode.USAGE),
+    NotADirectoryError: ("a part of the path is not a folder", ExitCode.USAGE),
+    PermissionError: ("permission denied", ExitCode.FAILURE),
+}
+
+
+def describe_os_error(err: OSError) -> tuple[str, ExitCode]:
+    """An OSError as one worded line and its exit code (a missing input is bad input, 2)."""
+    for kind, (words, code) in _OS_WORDS.items():
+        if isinstance(err, kind) and err.filename is not None:
+            name = str(err.filename)
+            return (
+                f"no such file: {name}" if kind is FileNotFoundError else f"{name}: {words}"
+            ), code
+    if err.strerror and err.filename is not None:
+        return f"{err.filename}: {err.strerror[:1].lower()}{err.strerror[1:]}", ExitCode.FAILURE
+    if err.strerror:
+        return err.strerror, ExitCode.FAILURE
+    return str(err), ExitCode.FAILURE
+
+
+def require_file(path: Path) -> None:
+    """Raise the worded OSError for an input that is missing or a folder."""
+    if path.is_dir():
+        raise IsADirectoryError(errno.EISDIR, "is a folder", str(path))
+    if not path.exists():
+        raise FileNotFoundError(errno.ENOENT, "no such file", str(path))

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -24,6 +25,8 @@ def write_simulation(
     params: str,
     profile: DriveProfile,
     situation: str | None,
+    mass_kg: float | None = None,
+    **extra: Any,
 ) -> None:
     """Write a simulated run; the suffix picks the format.
 
@@ -53,12 +56,16 @@ def write_simulation(
     command["t_ns"] = gauges["t_ns"]
     command["x_cmd_mm"] = gauges["x_mm"]
     what = f"situation {situation}" if situation else str(profile.spec.shape)
+    from labstand.commands.common import config_with_mass
+
+    stand = config.to_dict() if mass_kg is None else config_with_mass(config, mass_kg)
     metadata = make_metadata(
-        config.to_dict(),
+        stand,  # its default weight is the simulated one, as `run` stores it
         Backend.SIMULATE,
         sample_rate_hz=rate,
-        signal=profile.spec.to_dict(),
+        signal={**profile.spec.to_dict(), "situation": situation},
         operator_note=f"labstand simulate: {what}, parameter set {params!r}",
+        **extra,  # operator, sample, tags
     )
     end_ns = int(gauges["t_ns"][-1])
     events = [(0, "start", what), (end_ns, "stop", "end of simulation")]

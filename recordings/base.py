@@ -244,6 +244,7 @@ FORMAT_MODULES: dict[str, tuple[str, ...]] = {
     ".h5": ("recordings.hdf5io",),
     ".hdf5": ("recordings.hdf5io",),
     ".tdms": ("recordings.tdmsio",),
+    ".parquet": ("recordings.tables",),  # written by `convert`, read back here
 }
 
 

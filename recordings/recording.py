@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import errno
 import logging
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -190,6 +191,10 @@ def open_recording(
         A subclass naming the file and what is wrong (see ``recordings``).
     """
     p = Path(path)
+    if p.is_dir():  # before the suffix: a folder named x.mcap is no recording either
+        raise IsADirectoryError(errno.EISDIR, "is a folder, not a recording", str(p))
+    if not p.exists():  # before the suffix: "no such file" says more than "no reader"
+        raise FileNotFoundError(errno.ENOENT, "no such file", str(p))
     recording: Recording = reader_for(p)(p, salvage=salvage)
     recording.check()
     for line in recording.repairs if log_repairs else ():

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import json
 import socket
+import uuid
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
@@ -151,6 +152,12 @@ class RecordingMetadata:
         Free text.
     source
         For imports: the original file name; otherwise empty.
+    operator, sample
+        Who ran it, and the sample (fibre) it ran on: free text, empty if not given.
+    run_id
+        A UUID made when the run was recorded; conversions and cuts keep it.
+    tags
+        Free labels (``--tag``), in the order given.
     schema_version
         Version of this schema the file follows.
     """
@@ -166,6 +173,10 @@ class RecordingMetadata:
     operator_note: str = ""
     source: str = ""
     schema_version: int = SCHEMA_VERSION
+    operator: str = ""
+    sample: str = ""
+    run_id: str = ""
+    tags: tuple[str, ...] = ()
 
     @property
     def channels(self) -> dict[str, ChannelInfo]:
@@ -178,6 +189,16 @@ class RecordingMetadata:
         for name, unit in (("t_ns", "ns"), ("kind", ""), ("text", "")):
             out[f"events.{name}"] = ChannelInfo("events", unit, None)
         return out
+
+    @property
+    def mass_kg(self) -> float | None:
+        """The weight stored with the run (its stand's default weight), None if unreadable."""
+        try:
+            weights, weight = self.stand_config["weights_kg"], self.stand_config["weight"]
+            mass = float(weights[weight["default"]])
+        except (KeyError, TypeError, ValueError):
+            return None
+        return mass if mass > 0 else None
 
     @property
     def start_time_ns(self) -> int:
@@ -201,6 +222,10 @@ class RecordingMetadata:
             "host": self.host,
             "operator_note": self.operator_note,
             "source": self.source,
+            "operator": self.operator,
+            "sample": self.sample,
+            "run_id": self.run_id,
+            "tags": list(self.tags),
             "stand_config": dict(self.stand_config),
             "channels": {
                 k: {"stream": c.stream, "unit": c.unit, "rate_hz": c.rate_hz}
@@ -247,6 +272,10 @@ class RecordingMetadata:
                 operator_note=str(data.get("operator_note", "")),
                 source=str(data.get("source", "")),
                 schema_version=version_,
+                operator=str(data.get("operator", "")),
+                sample=str(data.get("sample", "")),
+                run_id=str(data.get("run_id", "")),
+                tags=_tags(data.get("tags", []), where),
             )
             _ = meta.start_time_ns
         except (KeyError, TypeError, ValueError, AttributeError, OverflowError) as err:
@@ -269,6 +298,15 @@ class RecordingMetadata:
         return cls.from_dict(data, where)
 
 
+def _tags(value: object, where: str) -> tuple[str, ...]:
+    """Older files have no tags; a list of strings otherwise."""
+    if not isinstance(value, list) or not all(isinstance(t, str) for t in value):
+        raise CorruptRecordingError(
+            f"{where}: metadata tags must be a list of text, got {shown(value)}"
+        )
+    return tuple(value)
+
+
 def software_version() -> str:
     """The installed labstand version (recordings may not import labstand itself)."""
     from importlib.metadata import PackageNotFoundError, version  # imports email: lazily
@@ -289,6 +327,9 @@ def make_metadata(
     operator_note: str = "",
     source: str = "",
     start: datetime | None = None,
+    operator: str = "",
+    sample: str = "",
+    tags: tuple[str, ...] = (),
 ) -> RecordingMetadata:
     """Metadata for a new recording, with this host, version and (default) start time now."""
     start = start or datetime.now(UTC)
@@ -303,6 +344,10 @@ def make_metadata(
         host=socket.gethostname(),
         operator_note=operator_note,
         source=source,
+        operator=operator,
+        sample=sample,
+        run_id=str(uuid.uuid4()),
+        tags=tags,
     )
 
 

@@ -65,6 +65,15 @@ def _bounds(start_s: float | None, end_s: float | None, span: tuple[int, int]) -
     return lo, hi
 
 
+#: The events of an open-ended window reach past the gauges: a run's final note (the
+#: simulated stand's last word) comes after its last sample.
+_OPEN = (-(2**62), 2**62)
+
+
+def _event_bounds(start_s: float | None, end_s: float | None, lo: int, hi: int) -> tuple[int, int]:
+    return (_OPEN[0] if start_s is None else lo, _OPEN[1] if end_s is None else hi)
+
+
 def _slice(block: NDArray[np.void], lo: int, hi: int) -> NDArray[np.void]:
     t = block["t_ns"]
     return block[int(np.searchsorted(t, lo, "left")) : int(np.searchsorted(t, hi, "right"))]
@@ -88,7 +97,9 @@ def _whole(path: Path, start_s: float | None, end_s: float | None) -> Window:
     span = (int(full.gauges["t_ns"][0]), int(full.gauges["t_ns"][-1]))
     _check(str(path), start_s, end_s, span)
     lo, hi = _bounds(start_s, end_s, span)
-    return Window(cut(full, lo, hi), lo / 1e9, hi / 1e9, span[0] / 1e9, span[1] / 1e9)
+    part = cut(full, lo, hi)
+    part.events_array = _slice(full.events_array, *_event_bounds(start_s, end_s, lo, hi))
+    return Window(part, lo / 1e9, hi / 1e9, span[0] / 1e9, span[1] / 1e9)
 
 
 class _FallbackError(Exception):
@@ -188,7 +199,9 @@ def _mcap_window(path: Path, start_s: float | None, end_s: float | None) -> Wind
             if drive is None:
                 raise _FallbackError("drive polls not in the fixed layout")
             streams["drive"] = _slice(_as(drive, DRIVE_DTYPE), lo, hi)
-            events = [parse(EVENT, d, where) for d in batches("/events", lo, hi)]
+            e_lo, e_hi = _event_bounds(start_s, end_s, lo, hi)
+            e_lo, e_hi = max(e_lo, -t0), min(e_hi, 2**63 - 1 - t0)
+            events = [parse(EVENT, d, where) for d in batches("/events", e_lo, e_hi)]
             streams["events"] = np.array(
                 [(e.t_ns, e.kind, e.text) for e in events], dtype=EVENTS_DTYPE
             ).reshape(len(events))
@@ -241,7 +254,7 @@ def _hdf5_window(path: Path, start_s: float | None, end_s: float | None) -> Wind
             events["t_ns"] = e["t_ns"]
             for key in ("kind", "text"):
                 events[key] = [v.decode() if isinstance(v, bytes) else str(v) for v in e[key]]
-            streams["events"] = _slice(events, lo, hi)
+            streams["events"] = _slice(events, *_event_bounds(start_s, end_s, lo, hi))
     except WindowError:
         raise
     except (OSError, KeyError, ValueError, TypeError) as err:

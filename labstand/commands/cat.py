@@ -3,10 +3,16 @@
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from labstand.errors import CommandError, ExitCode
+
+if TYPE_CHECKING:
+    import numpy as np
+    from numpy.typing import NDArray
 
 #: channel name -> column (the same names as the CSV export and the CSV importer)
 CHANNELS = {
@@ -80,7 +86,39 @@ def run(args: argparse.Namespace) -> int:
     columns = columns_for(args.channels, len(rec.command) > 0)
     if "x_cmd_mm" in columns and not len(rec.command):
         raise CommandError(f"{args.recording}: has no command stream (x_cmd)", ExitCode.USAGE)
-    frame = rec.frame().reset_index()
-    # floats by repr: the shortest text that reads back to the same number
-    frame[["t_s", *columns]].to_csv(sys.stdout, index=False, lineterminator="\n")
+    frame = rec.frame().reset_index()[["t_s", *columns]]
+    frame["t_s"] = [seconds_text(t) for t in rec.gauges["t_ns"].tolist()]
+    for name in columns:
+        if frame[name].dtype.kind == "f":
+            frame[name] = number_text(frame[name].to_numpy())
+    frame.to_csv(sys.stdout, index=False, lineterminator="\n")
     return 0
+
+
+#: Most decimals a gauge's resolution has (counts of 1 µm, 1 mN: 3 or 4).
+MAX_DECIMALS = 6
+
+
+def number_text(values: NDArray[np.float64]) -> list[str]:
+    """A column as text: at its resolution when its values sit on one, else exactly.
+
+    Gauge values are counts times a step (21.8542 is 218542 × 0.0001, stored as
+    21.854200000000002): printed to the step's decimals they read as measured. Values on
+    no such step (the model's output) print as repr, the shortest text that reads back.
+    """
+    import numpy as np
+
+    finite = values[np.isfinite(values)]
+    for decimals in range(1, MAX_DECIMALS + 1):
+        step = np.round(finite, decimals)
+        if np.all(np.abs(step - finite) <= 4 * np.spacing(np.abs(finite))):
+            text: list[str] = np.char.mod(f"%.{decimals}f", values).tolist()
+            return [t if np.isfinite(v) else "" for t, v in zip(text, values.tolist(), strict=True)]
+    return [repr(v) if math.isfinite(v) else "" for v in values.tolist()]
+
+
+def seconds_text(t_ns: int) -> str:
+    """Nanoseconds as exact decimal seconds (0.0, 0.0005, 12.000000001)."""
+    sign, t_ns = ("-", -t_ns) if t_ns < 0 else ("", t_ns)
+    whole, frac = divmod(t_ns, 1_000_000_000)
+    return f"{sign}{whole}.{f'{frac:09d}'.rstrip('0') or '0'}"

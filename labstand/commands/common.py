@@ -13,8 +13,13 @@ if TYPE_CHECKING:
 def add_stand_options(parser: argparse.ArgumentParser, params: bool = False) -> None:
     """--stand FILE (and --params NAME)."""
     parser.add_argument(
-        "--stand", type=Path, metavar="FILE", help="stand configuration (default: the paper's)"
+        "--stand",
+        type=Path,
+        metavar="FILE",
+        help="stand configuration (default: $LABSTAND_STAND, else ./labstand.toml, else the "
+        "paper's stand)",
     )
+    parser.set_defaults(find_stand=True)  # labstand.cli fills --stand in (labstand.stands)
     if params:
         parser.add_argument(
             "--params",
@@ -50,3 +55,20 @@ def config_with_mass(config: StandConfig, mass_kg: float) -> dict[str, Any]:
 
     config_from_dict(raw, config.source)  # still valid
     return raw
+
+
+def add_metadata_options(parser: argparse.ArgumentParser) -> None:
+    """--operator, --sample and --tag (repeatable): stored in the recording, listed by ls."""
+    group = parser.add_argument_group("run metadata (stored in the recording; labstand ls)")
+    group.add_argument("--operator", default="", metavar="NAME", help="who runs it")
+    group.add_argument("--sample", default="", metavar="ID", help="the sample (fibre) id")
+    group.add_argument(
+        "--tag", action="append", default=[], metavar="TAG", help="a free label (repeatable)"
+    )
+
+
+def metadata_options(args: argparse.Namespace) -> dict[str, Any]:
+    """The keywords of ``make_metadata`` / ``with_changes`` the options above give."""
+    out: dict[str, Any] = {"tags": tuple(args.tag)} if args.tag else {}
+    out.update({k: getattr(args, k) for k in ("operator", "sample") if getattr(args, k)})
+    return out

@@ -6,6 +6,7 @@ import argparse
 from pathlib import Path
 
 from labstand.errors import CommandError, ExitCode
+from labstand.targets import FILE
 
 
 def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -22,7 +23,7 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     )
     parser.add_argument("source", type=Path, metavar="A", help="recording to read")
     parser.add_argument("target", type=Path, metavar="B", help="recording to write")
-    parser.set_defaults(func=run)
+    parser.set_defaults(func=run, outputs={"target": FILE})
 
 
 def writable_suffixes() -> list[str]:

@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING
 
 from labstand.distributed import add_cluster_options
 from labstand.errors import CommandError, ExitCode
+from labstand.targets import FOLDER
 
 if TYPE_CHECKING:  # imported where they run: `diagnose --help` loads no numba or pandas
     from sim.config import StandConfig
@@ -34,7 +35,8 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
         type=Path,
         metavar="FILE",
         help="diagnose every campaign of a TOML manifest ([campaign.NAME] tables with "
-        "recordings, mass_kg, optional stand and truth), in parallel on Dask",
+        "recordings, optional mass_kg (default: each recording's stored weight), stand and "
+        "truth), in parallel on Dask",
     )
     parser.add_argument(
         "--results",
@@ -58,7 +60,7 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     )
     parser.add_argument("--json", action="store_true", help="print the result as JSON")
     parser.add_argument("--report", type=Path, metavar="DIR", help="write an HTML report here")
-    parser.set_defaults(func=run)
+    parser.set_defaults(func=run, outputs={"report": FOLDER, "results": FOLDER})
 
 
 def _mass_of(
@@ -69,16 +71,9 @@ def _mass_of(
         return override, "--mass-kg"
     if stand is not None:
         return stand.default_mass_kg, f"default weight of {stand.source}"
-    try:
-        from sim.config import config_from_dict
+    from labstand.campaigns import stored_mass
 
-        mass = config_from_dict(stored, str(path)).default_mass_kg  # type: ignore[arg-type]
-    except (ValueError, TypeError):  # sim.config.ConfigError is a ValueError
-        from sim.config import load_config
-
-        fallback = load_config(None).default_mass_kg
-        return fallback, "the paper stand's default weight (the stored stand is unreadable)"
-    return mass, "stored in the recording"
+    return stored_mass(path, stored)
 
 
 def run(args: argparse.Namespace) -> int:

@@ -21,6 +21,7 @@ from labstand.distributed import (
     say_failures,
 )
 from labstand.errors import CommandError, ExitCode
+from labstand.targets import FILE, FOLDER
 
 if TYPE_CHECKING:  # imported where they run: `diagnose-check --help` loads no numba
     from drivers.signals import SignalSpec
@@ -111,7 +112,7 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
         help="write the campaigns' table and the confusion matrix here",
     )
     add_cluster_options(parser)
-    parser.set_defaults(func=run)
+    parser.set_defaults(func=run, outputs={"output": FILE, "results": FOLDER})
 
 
 @dataclass(frozen=True)

@@ -7,8 +7,15 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-from labstand.commands.common import add_stand_options, config_with_mass, load_stand
-from labstand.errors import CommandError, ExitCode
+from labstand.commands.common import (
+    add_metadata_options,
+    add_stand_options,
+    config_with_mass,
+    load_stand,
+    metadata_options,
+)
+from labstand.errors import CommandError, ExitCode, require_file
+from labstand.targets import FILE
 
 MAP_HELP = """\
 which column holds which quantity: FIELD=COLUMN or FIELD=COLUMN[UNIT], repeatable.
@@ -43,6 +50,7 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
         "--map", action="append", default=[], metavar="FIELD=COLUMN[UNIT]", help=MAP_HELP
     )
     parser.add_argument("--note", default="", help="operator note stored in the metadata")
+    add_metadata_options(parser)
     parser.add_argument(
         "--mass-kg", type=float, help="weight mass of the run, kg (default: the stand's)"
     )
@@ -69,7 +77,7 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     parser.add_argument(
         "-o", "--output", type=Path, required=True, help="the recording (.mcap or .h5)"
     )
-    parser.set_defaults(func=run)
+    parser.set_defaults(func=run, outputs={"output": FILE})
 
 
 def run(args: argparse.Namespace) -> int:
@@ -79,6 +87,7 @@ def run(args: argparse.Namespace) -> int:
     from recordings.foreign import parse_mapping
     from recordings.tdmsio import read_tdms
 
+    require_file(args.file)  # before its suffix: "no such file" says more
     suffix = args.file.suffix.lower()
     if suffix not in {".csv", ".tdms"}:
         raise CommandError(
@@ -101,6 +110,7 @@ def run(args: argparse.Namespace) -> int:
     meta = recording.metadata
     if args.note:
         meta = with_changes(meta, operator_note=f"{args.note} ({meta.operator_note})")
+    meta = with_changes(meta, **metadata_options(args))
     write_recording(recording, args.output, meta)
     info = summary(recording)
     print(

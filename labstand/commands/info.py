@@ -27,7 +27,9 @@ def run(args: argparse.Namespace) -> int:
     from recordings import open_recording
     from recordings.convert import summary
 
-    info = summary(open_recording(args.recording, log_repairs=False))
+    recording = open_recording(args.recording, log_repairs=False)
+    info = summary(recording)
+    info["mass_kg"] = recording.metadata.mass_kg
     if args.json:
         print(json.dumps(info, indent=2))
     else:
@@ -45,10 +47,23 @@ def _print(info: dict[str, Any]) -> None:
     print(f"  written by labstand {meta['software_version']} on {meta['host'] or '?'}")
     if meta["signal"]:
         sig = meta["signal"]
+        situation = f"situation {sig['situation']}: " if sig.get("situation") else ""
         print(
-            f"  signal {sig['shape']}, A = {sig['amplitude_mm']:g} mm, "
+            f"  signal {situation}{sig['shape']}, A = {sig['amplitude_mm']:g} mm, "
             f"f = {sig['frequency_hz']:g} Hz, {sig['cycles']} cycle(s)"
         )
+    mass = info["mass_kg"]
+    print(f"  mass {mass:g} kg" if mass is not None else "  mass: not stored")
+    for effect in meta["effects"]:
+        params = ", ".join(f"{k} = {v:g}" for k, v in effect["params"].items())
+        print(f"  simulated effect {effect['name']}" + (f": {params}" if params else ""))
+    who = [f"{k} {meta[k]}" for k in ("operator", "sample") if meta.get(k)]
+    if meta.get("tags"):
+        who.append("tags " + ", ".join(meta["tags"]))
+    if who:
+        print(f"  {'; '.join(who)}")
+    if meta.get("run_id"):
+        print(f"  run {meta['run_id']}")
     if meta["operator_note"]:
         print(f"  note: {meta['operator_note']}")
     print("  channels:")

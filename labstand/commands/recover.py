@@ -6,6 +6,7 @@ import argparse
 from pathlib import Path
 
 from labstand.errors import CommandError, ExitCode
+from labstand.targets import FILE
 
 
 def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -19,7 +20,7 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     )
     parser.add_argument("broken", type=Path, metavar="BROKEN", help="the damaged recording")
     parser.add_argument("-o", "--output", type=Path, required=True, metavar="FIXED")
-    parser.set_defaults(func=run)
+    parser.set_defaults(func=run, outputs={"output": FILE})
 
 
 def run(args: argparse.Namespace) -> int:

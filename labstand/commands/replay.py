@@ -10,6 +10,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from labstand.distributed import add_cluster_options, run_many
+from labstand.targets import FILE, check_output
 
 if TYPE_CHECKING:  # imported where they run: `replay --help` loads no numba or pandas
     from sim.metrics import ChannelMetrics
@@ -60,7 +61,7 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
         "named PNG's name + '-' + the recording's stem (--plot out/r.png: out/r-s11.png, ...)",
     )
     add_cluster_options(parser)
-    parser.set_defaults(func=run)
+    parser.set_defaults(func=run, outputs={"plot": FILE})
 
 
 @dataclass(frozen=True)
@@ -112,6 +113,8 @@ def plot_paths(plot: Path, recordings: Sequence[Path]) -> list[Path]:
 def run(args: argparse.Namespace) -> int:
     """Replay each recording (several in parallel on Dask) and report."""
     plots = plot_paths(args.plot, args.recordings) if args.plot is not None else None
+    for plot in plots or ():  # one per recording: each checked before any replay
+        check_output(plot, args.force, option="--plot")
     jobs = [
         ReplayJob(p, args.params, args.stand, args.mass_kg, plots[i] if plots else None)
         for i, p in enumerate(args.recordings)

@@ -13,6 +13,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import logging
+import math
 import os
 import signal
 import sys
@@ -25,7 +26,13 @@ from types import FrameType
 from typing import TYPE_CHECKING, Any
 
 from drivers.signals import SignalSpec, plan_motion
-from labstand.commands.common import add_stand_options, config_with_mass, load_stand
+from labstand.commands.common import (
+    add_metadata_options,
+    add_stand_options,
+    config_with_mass,
+    load_stand,
+    metadata_options,
+)
 from labstand.commands.simulate import add_signal_options, signal_from_args
 from labstand.errors import CommandError, ExitCode
 from labstand.live.address import ViewerAddress, parse_address
@@ -40,6 +47,7 @@ from labstand.session import (
 from labstand.session.display import make_display
 from labstand.session.record import RecordingPipe
 from labstand.session.safety import EStopError, SafetyLimits
+from labstand.targets import FILE
 from recordings.base import open_writer
 from recordings.schema import Effect, RecordingMetadata, make_metadata
 
@@ -70,6 +78,7 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     )
     parser.add_argument("-o", "--output", type=Path, required=True, help="recording (.mcap, .h5)")
     parser.add_argument("--note", default="", help="operator note, stored in the recording")
+    add_metadata_options(parser)
     parser.add_argument("--yes", action="store_true", help="start without asking (stand)")
     parser.add_argument(
         "--reset-trip", action="store_true", help="reset a tripped drive during pre-flight"
@@ -104,7 +113,7 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     )
     # for tests: faults injected by the simulated stand (sim/hardware/faults.py)
     parser.add_argument("--sim-fault", action="append", default=[], help=argparse.SUPPRESS)
-    parser.set_defaults(func=run)
+    parser.set_defaults(func=run, outputs={"output": FILE})
 
 
 def _title(args: argparse.Namespace, spec: SignalSpec, mass_kg: float) -> str:
@@ -145,6 +154,8 @@ def _check(args: argparse.Namespace) -> _Plan:
 
     config = load_stand(args)
     spec, mass = signal_from_args(args, config)
+    if not (math.isfinite(mass) and mass > 0):  # before the simulated stand starts with it
+        raise CommandError(f"--mass-kg: mass must be > 0 kg, got {mass:g} kg", ExitCode.USAGE)
     from labstand.session.devices import BACKENDS, default_backend
 
     backend = args.backend or default_backend(config)
@@ -176,8 +187,6 @@ def _check(args: argparse.Namespace) -> _Plan:
             f"{', '.join(writable)}",
             ExitCode.USAGE,
         )
-    if not args.output.parent.is_dir():
-        raise CommandError(f"{args.output.parent}: no such directory", ExitCode.USAGE)
     confirm = backend == "stand" and not args.yes
     if confirm and not sys.stdin.isatty():
         raise CommandError(
@@ -222,6 +231,8 @@ def _run_devices(args: argparse.Namespace, plan: _Plan, live: LiveView | None) -
         title = _title(args, plan.spec, plan.mass_kg)
         _say(f"labstand run: {title}")
         _say(f"  {plan.backend}: {devices.where}")
+        if getattr(args, "stand_origin", ""):
+            _say(f"  stand file: {args.stand} (from {args.stand_origin})")
         display = make_display(sys.stdout)
         if live is not None:
             display = live.display(display)
@@ -274,6 +285,7 @@ def _session(
             signal={**plan.spec.to_dict(), "situation": args.situation},
             effects=tuple(Effect(e.name, e.resolved()) for e in plan.effects),
             operator_note=args.note,
+            **metadata_options(args),
         )
         return _record(session, devices, metadata, args, stop, title, live)
 

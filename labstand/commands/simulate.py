@@ -13,8 +13,14 @@ import numpy as np
 
 # Light (numpy only): the parser's choices. The model (numba, scipy) is imported in run().
 from drivers.signals import DriveProfile, Shape, SignalSpec, plan_motion
-from labstand.commands.common import add_stand_options, load_stand
+from labstand.commands.common import (
+    add_metadata_options,
+    add_stand_options,
+    load_stand,
+    metadata_options,
+)
 from labstand.errors import CommandError, ExitCode
+from labstand.targets import FILE
 from sim.situations import SITUATIONS, situation
 
 if TYPE_CHECKING:
@@ -86,6 +92,7 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     add_stand_options(parser, params=True)
     parser.add_argument("-o", "--output", type=Path, help="write the run here (.csv, ...)")
     parser.add_argument("--plot", type=Path, metavar="PNG", help="plot x, u and F to a PNG")
+    add_metadata_options(parser)
     parser.add_argument("--json", action="store_true", help="print a JSON summary")
     effects = parser.add_argument_group("unmodelled effects (docs/effects.md)")
     effects.add_argument(
@@ -98,7 +105,7 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
         "--noise", action="store_true", help="add realistic gauge noise, mains hum, quantisation"
     )
     effects.add_argument("--seed", type=int, default=0, help="seed of --noise (default 0)")
-    parser.set_defaults(func=run)
+    parser.set_defaults(func=run, outputs={"output": FILE, "plot": FILE})
 
 
 def summarise(result: SimResult, profile: DriveProfile, mass_kg: float) -> dict[str, Any]:
@@ -145,7 +152,16 @@ def run(args: argparse.Namespace) -> int:
     summary["situation"] = args.situation
     summary["wall_s"] = elapsed
     if args.output is not None:
-        write_simulation(args.output, result, config, args.params, profile, args.situation)
+        write_simulation(
+            args.output,
+            result,
+            config,
+            args.params,
+            profile,
+            args.situation,
+            mass,
+            **metadata_options(args),
+        )
         summary["output"] = str(args.output)
     if args.plot is not None:
         from labstand.plots import plot_run

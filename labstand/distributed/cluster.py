@@ -101,10 +101,12 @@ def open_client(
     """
     from distributed import Client, LocalCluster
 
-    # Dask configures its loggers at INFO on import: its connection chatter would bury the
-    # progress line; -v (labstand's DEBUG) keeps it.
-    if not logging.getLogger("labstand").isEnabledFor(logging.DEBUG):
-        logging.getLogger("distributed").setLevel(logging.WARNING)
+    # Dask configures its loggers at INFO on import: its connection chatter, and its
+    # warnings while it stops (a busy worker killed after Ctrl-C), would bury the progress
+    # and the one closing line; -v (labstand's DEBUG) keeps them.
+    verbose = logging.getLogger("labstand").isEnabledFor(logging.DEBUG)
+    if not verbose:
+        logging.getLogger("distributed").setLevel(logging.ERROR)
     if options.scheduler is not None:
         try:
             client = Client(options.scheduler, timeout=CONNECT_TIMEOUT)
@@ -135,8 +137,11 @@ def open_client(
             # A free loopback port: the scheduler serves HTTP even without a dashboard
             # (its default, 8787, may be taken by another cluster).
             dashboard_address="127.0.0.1:0",
-            silence_logs=logging.ERROR,
+            # the workers' own log: a busy worker outlives the scheduler after Ctrl-C
+            # and says so with a traceback (heartbeat failed); -v keeps their errors
+            silence_logs=logging.ERROR if verbose else logging.CRITICAL,
             env={"NUMBA_NUM_THREADS": str(threads)},
+            preload=["labstand.distributed.worker_signals"],  # Ctrl-C: the parent's alone
         ) as cluster,
         Client(cluster) as client,
     ):

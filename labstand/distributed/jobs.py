@@ -22,6 +22,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Generic, TypeVar
 
 from labstand.distributed.progress import Progress
+from labstand.errors import ExitCode, describe_os_error
 from labstand.interrupts import remembered_interrupt
 
 if TYPE_CHECKING:  # dask is imported where it runs: a command's --help stays quick
@@ -79,8 +80,11 @@ def call_job(
         value = fn(item)
     except Exception as err:  # the job's failure is data, reported in its row
         seconds = time.perf_counter() - started
-        message = str(err) or repr(err)
-        return None, message, type(err).__name__, seconds, _where(), isinstance(err, ValueError)
+        message, bad = str(err) or repr(err), isinstance(err, ValueError)
+        if isinstance(err, OSError):  # in words, as the command line says it (labstand.errors)
+            message, code = describe_os_error(err)
+            bad = code == ExitCode.USAGE
+        return None, message, type(err).__name__, seconds, _where(), bad
     return value, None, None, time.perf_counter() - started, _where(), False
 
 

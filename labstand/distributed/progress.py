@@ -1,12 +1,13 @@
-"""Progress of many jobs on stderr: a bar with done/total and ETA, or one line per job."""
+"""Progress of many jobs on stderr: a rich bar with done/total and ETA, or one line per job."""
 
 from __future__ import annotations
 
 import sys
 import time
-from typing import TextIO
+from typing import TYPE_CHECKING, TextIO
 
-BAR_WIDTH = 28
+if TYPE_CHECKING:  # rich is imported when a bar is drawn (a terminal), not with this module
+    import rich.progress
 
 
 def _clock(seconds: float) -> str:
@@ -17,9 +18,10 @@ def _clock(seconds: float) -> str:
 class Progress:
     """Reports jobs as they finish.
 
-    On a terminal a bar redrawn in place; elsewhere (a log file, a pipe) one line per job
-    so nothing is lost. ``quiet`` (``--json``) says nothing but the messages passed to
-    ``say`` with ``always=True``.
+    On a terminal a rich progress bar (as the run's live panel) with each job's line
+    printed above it; elsewhere (a log file, a pipe) one line per job so nothing is lost.
+    ``quiet`` (``--json``) says nothing but the messages passed to ``say`` with
+    ``always=True``.
     """
 
     def __init__(
@@ -31,15 +33,38 @@ class Progress:
         self.quiet = quiet
         self.stream = stream if stream is not None else sys.stderr
         self.started = time.monotonic()
-        self._bar = not quiet and self.stream.isatty()
+        self._bar: rich.progress.Progress | None = None
+        if not quiet and self.stream.isatty():
+            self._bar = self._start_bar()
+
+    def _start_bar(self) -> rich.progress.Progress:
+        from rich.console import Console
+        from rich.progress import (
+            BarColumn,
+            MofNCompleteColumn,
+            TextColumn,
+            TimeRemainingColumn,
+        )
+        from rich.progress import Progress as Bar
+
+        bar = Bar(
+            TextColumn("{task.description}", markup=False),
+            BarColumn(),
+            MofNCompleteColumn(),
+            TextColumn("ETA"),
+            TimeRemainingColumn(),
+            console=Console(file=self.stream, highlight=False),
+            transient=True,  # closed: the bar's line goes, the jobs' lines stay
+        )
+        self._task = bar.add_task(self.label, total=self.total)
+        bar.start()
+        return bar
 
     def say(self, message: str, always: bool = False) -> None:
         """A line of its own (above the bar)."""
         if self.quiet and not always:
             return
-        self._clear()
-        print(f"{self.label}: {message}", file=self.stream, flush=True)
-        self._draw()
+        self._line(f"{self.label}: {message}")
 
     def eta_s(self) -> float | None:
         """Seconds left at the rate so far (None before the first job finished)."""
@@ -53,33 +78,23 @@ class Progress:
         self.done += 1
         if self.quiet:
             return
+        if self._bar is not None:
+            self._line(f"{self.label}: {what}")
+            self._bar.update(self._task, completed=self.done)
+            return
         eta = self.eta_s()
         left = "" if eta is None or self.done == self.total else f", ETA {_clock(eta)}"
-        if self._bar:
-            self._clear()
-            print(f"{self.label}: {what}", file=self.stream, flush=True)
-            self._draw()
-        else:
-            print(f"{self.label}: [{self.done}/{self.total}{left}] {what}", file=self.stream,
-                  flush=True)  # fmt: skip
+        print(f"{self.label}: [{self.done}/{self.total}{left}] {what}", file=self.stream,
+              flush=True)  # fmt: skip
 
     def close(self) -> None:
-        """End the bar's line."""
-        if self._bar:
-            self._clear()
-            self._bar = False
+        """Stop the bar (its line is cleared)."""
+        if self._bar is not None:
+            self._bar.stop()
+            self._bar = None
 
-    def _draw(self) -> None:
-        if not self._bar:
-            return
-        filled = BAR_WIDTH * self.done // max(self.total, 1)
-        eta = self.eta_s()
-        left = "ETA --:--:--" if eta is None else f"ETA {_clock(eta)}"
-        bar = "#" * filled + "." * (BAR_WIDTH - filled)
-        self.stream.write(f"\r[{bar}] {self.done}/{self.total} {left} ")
-        self.stream.flush()
-
-    def _clear(self) -> None:
-        if self._bar:
-            self.stream.write("\r\033[K")
-            self.stream.flush()
+    def _line(self, text: str) -> None:
+        if self._bar is not None:
+            self._bar.console.print(text, markup=False, highlight=False, soft_wrap=True)
+        else:
+            print(text, file=self.stream, flush=True)

@@ -129,13 +129,26 @@ class Player:
             if model is not None:
                 self.publisher.model(block["t_ns"], model.advance(block))
             stats.samples += len(block)
+        if stop is None or not stop():  # after the last sample: the final polls and note
+            for t_ns, kind, text in events[i_event:].tolist():
+                while i_drive < len(drive) and drive["t_ns"][i_drive] <= t_ns:
+                    self.publisher.drive(_row(drive[i_drive]))
+                    i_drive += 1
+                self._wait(t0, int(t_ns))
+                self.publisher.event(int(t_ns), str(kind), str(text))
+                i_event += 1
+            for row in drive[i_drive:]:
+                self.publisher.drive(_row(row))
+                i_drive += 1
         stats.drive, stats.events = i_drive, i_event
         return stats
 
     @property
     def span_ns(self) -> int:
-        """Recording time one pass covers, ns."""
-        return int(self.recording.gauges["t_ns"][-1]) - self.start_ns
+        """Recording time one pass covers (to the last sample, poll or event), ns."""
+        rec = self.recording
+        last = [int(a["t_ns"][-1]) for a in (rec.gauges, rec.drive, rec.events_array) if len(a)]
+        return max(last) - self.start_ns
 
 
 def _row(row: np.void) -> dict[str, Any]:

@@ -235,6 +235,10 @@ class Session(SessionLoop):
         else:
             self.disable()
         self._tail()
+        if outcome is Outcome.STOPPED and stop.presses >= 2 and "immediate" not in reason:
+            # the second press came once the controlled stop was done: what the terminal
+            # said ("disabling the drive at once") is what the recording and the end say
+            outcome, reason = self._immediate(after=reason)
         self._show(force=True)
         return RunResult(
             outcome,
@@ -270,9 +274,11 @@ class Session(SessionLoop):
                     name = state.name.lower()
                     raise EStopError(f"the drive program stopped the profile (state {name})")
 
-    def _immediate(self) -> tuple[Outcome, str]:
+    def _immediate(self, after: str = "") -> tuple[Outcome, str]:
         self.disable()
         reason = f"Ctrl-C twice at {self._elapsed():.2f} s: immediate disable"
+        if after:
+            reason = f"{after}, then {reason}"
         self._event("estop", reason)
         return Outcome.STOPPED, reason
 

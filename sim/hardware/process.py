@@ -65,15 +65,24 @@ class StandProcess:
         ready, _, _ = select.select([self.process.stdout], [], [], self._timeout)
         line = self.process.stdout.readline() if ready else ""
         if not line:
+            if ready:  # its stdout closed: the child is ending, and its stderr says why
+                with contextlib.suppress(subprocess.TimeoutExpired):
+                    self.process.wait(self._timeout)
+            why = self._stderr()  # read before stop(), which closes the pipes
             self.stop()
-            raise StandStartError(f"the simulated stand did not start: {self._stderr()}")
+            raise StandStartError(f"the simulated stand did not start: {why}")
         self.endpoints = json.loads(line)
         return self.endpoints
 
     def _stderr(self) -> str:
+        """The child's last line on stderr, without its own ``labstand: error:`` prefix."""
         if self.process is None or self.process.stderr is None or self.process.poll() is None:
-            return "no ready line in time"
-        return self.process.stderr.read().strip()[-2000:]
+            return f"no ready line within {self._timeout:g} s"
+        lines = [x.strip() for x in self.process.stderr.read().splitlines() if x.strip()]
+        last = lines[-1] if lines else f"it exited with code {self.process.returncode}"
+        for prefix in ("labstand: error: ", "labstand: refused: "):
+            last = last.removeprefix(prefix)
+        return last[-2000:]
 
     def stop(self, timeout_s: float = 5.0) -> int | None:
         """SIGTERM and wait; SIGKILL if it does not exit in time. Returns the exit code."""

@@ -20,7 +20,7 @@ def test_a_write_into_a_missing_folder_names_the_users_path(
     tmp_path: Path, suffix: str, capsys: pytest.CaptureFixture[str]
 ) -> None:
     target = tmp_path / "absent" / f"x{suffix}"
-    assert main(["simulate", "--situation", "11", "-o", str(target)]) == 1
+    assert main(["simulate", "--situation", "11", "-o", str(target)]) == 2
     err = capsys.readouterr().err
     assert err == f"labstand: error: {target}: cannot write: no such folder {target.parent}\n"
     assert not (tmp_path / "absent").exists()
@@ -32,7 +32,7 @@ def test_a_write_below_a_file_names_the_users_path(
     a_file = tmp_path / "s11.csv"
     a_file.write_text("not a folder\n")
     target = a_file / "x.h5"
-    assert main(["simulate", "--situation", "11", "-o", str(target)]) == 1
+    assert main(["simulate", "--situation", "11", "-o", str(target)]) == 2
     err = capsys.readouterr().err
     assert err == f"labstand: error: {target}: cannot write: {a_file} is not a folder\n"
 
@@ -47,7 +47,7 @@ def test_convert_and_recover_name_the_users_target(
         (["convert", str(rec), str(tmp_path / "no" / "y.h5")], tmp_path / "no" / "y.h5"),
         (["recover", str(rec), "-o", str(tmp_path / "no" / "y.mcap")], tmp_path / "no" / "y.mcap"),
     ):
-        assert main(argv) == 1
+        assert main(argv) == 2
         err = capsys.readouterr().err
         assert err.startswith(f"labstand: error: {target}: cannot write") and ".part" not in err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["s11.mcap"]  # no stub left

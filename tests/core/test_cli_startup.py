@@ -151,3 +151,13 @@ def test_info_reads_an_mcap_without_the_model_or_other_formats(tmp_path: Path) -
     assert "8001 samples" in res.stdout
     imported = {line.split("|")[-1].strip().split(".")[0] for line in res.stderr.splitlines()}
     assert imported & set(HEAVY) == {"mcap"}  # its own reader, nothing else heavy
+
+
+def test_short_version_flag() -> None:
+    import subprocess
+    import sys
+
+    done = subprocess.run(
+        [sys.executable, "-m", "labstand", "-V"], capture_output=True, text=True, check=False
+    )
+    assert done.returncode == 0 and done.stdout.startswith("labstand ")

@@ -68,11 +68,11 @@ def test_the_check_runs_its_campaigns_on_two_workers(
     # The campaigns of tests/identify's serial check (seed 11): there both are right.
     args = ["diagnose-check", "--small", "--seed", "11", "--mass-kg", "8.131", "--effects",
             "none", "dial_gauge_calibration", "--workers", "2", "--json",
-            "--results", str(tmp_path)]  # fmt: skip
+            "--results", str(tmp_path / "results")]  # fmt: skip
     assert main(args) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["cases"] == 2 and out["accuracy"] == 1.0
-    table = pd.read_parquet(tmp_path / "campaigns.parquet")
+    table = pd.read_parquet(tmp_path / "results" / "campaigns.parquet")
     assert list(table["name"]) == ["none@8.131kg#0", "dial_gauge_calibration@8.131kg#0"]
     assert list(table["answer"]) == ["none", "dial_gauge_calibration"]
     assert table["worker"].str.startswith("tcp://127.0.0.1:").all()

@@ -35,7 +35,7 @@ def test_paths_are_relative_to_the_manifest(tmp_path: Path) -> None:
         ("title = 'x'\n", "m.toml: no [campaign.NAME] tables"),
         ("[campaign.a]\nrecordings = []\nmass_kg = 3\n",
          "[campaign.a]: recordings must be a non-empty list of paths"),
-        (f"{A}\n", "[campaign.a]: mass_kg must be a number > 0, got None"),
+        (f"{A}mass_kg = 'heavy'\n", "[campaign.a]: mass_kg must be a number > 0, got 'heavy'"),
         (f"{A}mass_kg = -3\n", "mass_kg must be a number > 0, got -3"),
         (f"{A}mass_kg = 3\nmass = 4\n",
          "[campaign.a]: unknown key(s) mass (known: mass_kg, recordings, stand, truth)"),
@@ -57,7 +57,7 @@ def test_campaigns_refuse_what_the_manifest_says_and_a_missing_file(
 ) -> None:
     missing = tmp_path / "none.toml"
     assert main(["diagnose", "--campaigns", str(missing)]) == 2
-    assert f"{missing}: cannot read the manifest" in capsys.readouterr().err
+    assert f"cannot read the manifest: no such file: {missing}" in capsys.readouterr().err
     assert main(["diagnose", "x.csv", "--campaigns", str(missing)]) == 2
     assert "--campaigns takes the recordings" in capsys.readouterr().err
     assert main(["diagnose"]) == 2

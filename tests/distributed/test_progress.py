@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import io
 import os
+import re
 import select
 
 from labstand.distributed import Progress
@@ -24,9 +25,13 @@ def test_on_a_terminal_a_bar_with_done_total_and_eta() -> None:
     finally:
         os.close(master)
         os.close(slave)
+    assert "labstand diagnose: local cluster: 2 worker process(es)" in text
     assert "labstand diagnose: light: none (20 s)" in text
-    assert "[#######" + "." * 21 + "] 1/4 ETA 0:00:00" in text  # 1 of 4: a quarter filled
-    assert text.endswith("\r\x1b[K")  # closed: the bar's line is cleared
+    plain = re.sub(r"\x1b\[[0-9;?]*[A-Za-z]", "", text)  # the drawn text without colours
+    assert re.search(r"labstand diagnose ━+ 0/4 ETA", plain)  # rich's bar, as the run's panel
+    assert re.search(r"labstand diagnose ━{10}╺━+ 1/4 ETA", plain)  # a quarter filled
+    assert text.endswith("\x1b[2K")  # closed: the bar's line is cleared (the jobs' stay)
+    assert "\x1b[?25h" in text  # and the cursor shown again
 
 
 def test_elsewhere_one_line_per_job_and_quiet_for_json() -> None:

@@ -356,7 +356,7 @@ def test_cli_writes_the_truth_into_its_json(tmp_path: Path) -> None:
     assert json.loads(out.read_text())["truth"] == "other"
     assert json.loads(out.read_text())["recordings"] == "moderate"
     args = ["diagnose-check", "--truth", "other", "--recordings", "brisk", "--effects"]
-    assert main([*args, "-o", str(out)]) == 0
+    assert main([*args, "-o", str(out), "--force"]) == 0  # (without: refused, exists)
     assert json.loads(out.read_text())["recordings"] == "brisk"
 
 

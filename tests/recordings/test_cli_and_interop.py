@@ -40,6 +40,8 @@ def test_recover_an_intact_file_and_refuse_overwriting(simulated_mcap: Path, tmp
         open_recording(fixed).gauges, open_recording(simulated_mcap).gauges
     )
     assert main(["convert", str(simulated_mcap), str(simulated_mcap)]) == 2
+    assert "exists; nothing written (give --force" in capsys.readouterr().err
+    assert main(["convert", str(simulated_mcap), str(simulated_mcap), "--force"]) == 2
     assert "would overwrite the source" in capsys.readouterr().err
     assert main(["convert", str(simulated_mcap), str(tmp_path / "x.xlsx")]) == 2
     assert "cannot write '.xlsx'" in capsys.readouterr().err

@@ -39,13 +39,13 @@ def test_spreadsheet_export_with_comma_decimals_preamble_and_cp1252(tmp_path: Pa
     header = sep.join(["t_s", "x_mm", "u_mm", "F_N"])
     text = "\r\n".join([*preamble, header, *_rows(sep, ",")]) + "\r\n"
     src.write_bytes(text.encode("cp1252"))
-    args = ["import", str(src), "--decimal", ",", "--encoding", "cp1252", "-o", str(out)]
+    args = ["import", str(src), "--decimal", ",", "--encoding", "cp1252", "-o", str(out), "--force"]
     assert main(args) == 0, capsys.readouterr().err
     _check_values(out)
     note = open_recording(out).metadata.operator_note
     assert "Export from stand PC 3, Prüfstand Süd / # Operator: Müller; 20 °C" in note
     # read as UTF-8 (the default), the same bytes are refused, naming the line
-    assert main(["import", str(src), "--decimal", ",", "-o", str(out)]) == 2
+    assert main(["import", str(src), "--decimal", ",", "-o", str(out), "--force"]) == 2
     err = capsys.readouterr().err
     assert err.startswith(f"labstand: error: {src}: line 1: not utf-8 text (byte 0xfc; try ")
     assert err.count("\n") == 1
@@ -59,12 +59,15 @@ def test_units_in_the_header_and_skip_rows(tmp_path: Path, capsys):
         for t, x, u, f in zip(T, X, U, F, strict=True)
     ]
     src.write_text("\n".join([*lines, *rows]) + "\n", encoding="utf-8")
-    assert main(["import", str(src), "--decimal", ",", "--skip-rows", "2", "-o", str(out)]) == 0
+    assert (
+        main(["import", str(src), "--decimal", ",", "--skip-rows", "2", "-o", str(out), "--force"])
+        == 0
+    )
     _check_values(out)
     assert "preamble: Stand PC export / Run 17" in open_recording(out).metadata.operator_note
     capsys.readouterr()
     # without --skip-rows the first line is taken as the header
-    assert main(["import", str(src), "--decimal", ",", "-o", str(out)]) == 2
+    assert main(["import", str(src), "--decimal", ",", "-o", str(out), "--force"]) == 2
     assert capsys.readouterr().err.endswith(
         "line 4: 't [ms];x [mm];u [m];F [kN]': 4 fields where the header (line 1) has 1 "
         "(a preamble? skip it with --skip-rows N)\n"
@@ -93,33 +96,33 @@ def test_malformed_lines_name_the_line_and_show_it_shortened(tmp_path: Path, cap
         "# Export\nt_s;x_mm;u_mm;F_N\n0;1;2;3\n0,0005;1;2;3;" + long_tail + "\n",
         encoding="utf-8",
     )
-    assert main(["import", str(src), "--decimal", ",", "-o", str(out)]) == 2
+    assert main(["import", str(src), "--decimal", ",", "-o", str(out), "--force"]) == 2
     err = capsys.readouterr().err
     assert err.startswith(f"labstand: error: {src}: line 4: '0,0005;1;2;3;9,5;9,5;")
     assert err.endswith("…': 44 fields where the header (line 2) has 4\n")
     assert len(err) - len(str(src)) < 150 and not out.exists()
     # comma decimals read with the default '.': the error says what to try
     src.write_text("t_s;x_mm;u_mm;F_N\n0;1,5;2;3\n", encoding="utf-8")
-    assert main(["import", str(src), "-o", str(out)]) == 2
+    assert main(["import", str(src), "-o", str(out), "--force"]) == 2
     assert capsys.readouterr().err == (
         f"labstand: error: {src}: line 2: '0;1,5;2;3': column 'x_mm': '1,5' is not a finite "
         "number (comma decimals? use --decimal ,)\n"
     )
     # a short line: the missing field is named
     src.write_text("t_s,x_mm,u_mm,F_N\n0,1,2,3\n0.0005,1,2\n", encoding="utf-8")
-    assert main(["import", str(src), "-o", str(out)]) == 2
+    assert main(["import", str(src), "-o", str(out), "--force"]) == 2
     assert "line 3: '0.0005,1,2': column 'F_N': empty" in capsys.readouterr().err
 
 
 def test_bad_options_are_refused(tmp_path: Path, capsys):
     src, out = tmp_path / "run.csv", tmp_path / "out.mcap"
     src.write_text("t_s,x_mm,u_mm,F_N\n0,1,2,3\n0.0005,1,2,3\n", encoding="utf-8")
-    assert main(["import", str(src), "--decimal", ",", "-o", str(out)]) == 2
+    assert main(["import", str(src), "--decimal", ",", "-o", str(out), "--force"]) == 2
     assert "with --decimal , the separator must be ';' or tab" in capsys.readouterr().err
-    assert main(["import", str(src), "--encoding", "klingon", "-o", str(out)]) == 2
+    assert main(["import", str(src), "--encoding", "klingon", "-o", str(out), "--force"]) == 2
     assert capsys.readouterr().err == "labstand: error: --encoding 'klingon': unknown encoding\n"
-    assert main(["import", str(src), "--skip-rows", "-1", "-o", str(out)]) == 2
+    assert main(["import", str(src), "--skip-rows", "-1", "-o", str(out), "--force"]) == 2
     assert "--skip-rows -1: must be 0 or more" in capsys.readouterr().err
-    assert main(["import", str(src), "--skip-rows", "5", "-o", str(out)]) == 2
+    assert main(["import", str(src), "--skip-rows", "5", "-o", str(out), "--force"]) == 2
     assert "no header line" in capsys.readouterr().err
     assert not out.exists()

@@ -189,6 +189,7 @@ def test_unknown_suffix(tmp_path: Path, meta):
         str(info.value)
         == f"{tmp_path / 'run.txt'}: cannot write '.txt'; use one of .h5, .hdf5, .mcap"
     )
+    (tmp_path / "run.bin").write_bytes(b"\x00")  # a missing file is "no such file" first
     with pytest.raises(UnknownFormatError, match=r"cannot read '\.bin'; use one of \.csv, "):
         open_recording(tmp_path / "run.bin")
 
@@ -227,5 +228,5 @@ def test_cli_reports_one_line_and_exit_code_2(tmp_path: Path, meta, capsys):
     err = capsys.readouterr().err
     assert err.startswith(f"labstand: error: {path}: the file is truncated")
     assert err.count("\n") == 1 and "Traceback" not in err
-    assert main(["info", str(tmp_path / "missing.h5")]) == 1
-    assert "No such file" in capsys.readouterr().err
+    assert main(["info", str(tmp_path / "missing.h5")]) == 2  # a missing input is bad input
+    assert capsys.readouterr().err == f"labstand: error: no such file: {tmp_path / 'missing.h5'}\n"

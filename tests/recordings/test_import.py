@@ -114,6 +114,7 @@ def test_cli_import_errors_are_one_line(tmp_path: Path, capsys):
     assert main(["import", str(src), "--map", "x", "-o", str(tmp_path / "o.h5")]) == 2
     err = capsys.readouterr().err
     assert err == "labstand: error: --map 'x': expected FIELD=COLUMN or FIELD=COLUMN[UNIT]\n"
+    (tmp_path / "run.txt").write_text("1,2,3\n")  # (a missing one is "no such file" first)
     assert main(["import", str(tmp_path / "run.txt"), "-o", str(tmp_path / "o.h5")]) == 2
     assert "cannot import '.txt'; use .csv or .tdms" in capsys.readouterr().err
 

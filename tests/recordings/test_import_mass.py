@@ -29,7 +29,7 @@ def _replay(capsys: pytest.CaptureFixture[str], *args: str) -> dict:
 
 def test_imported_light_run_replays_with_its_stored_mass(light_csv: Path, tmp_path: Path, capsys):
     rec = tmp_path / "light.mcap"
-    assert main(["import", str(light_csv), "--mass-kg", "3.096", "-o", str(rec)]) == 0
+    assert main(["import", str(light_csv), "--mass-kg", "3.096", "-o", str(rec), "--force"]) == 0
     assert "weight 3.096 kg (--mass-kg), stored with it" in capsys.readouterr().out
     out = _replay(capsys, str(rec))
     assert out["mass_kg"] == 3.096 and out["mass_source"] == "stored in the recording"
@@ -54,7 +54,7 @@ def test_import_without_mass_uses_the_stands_default_and_says_so(
     light_csv: Path, tmp_path: Path, capsys
 ):
     rec = tmp_path / "default.h5"
-    assert main(["import", str(light_csv), "-o", str(rec)]) == 0
+    assert main(["import", str(light_csv), "-o", str(rec), "--force"]) == 0
     assert "weight 8.131 kg (the paper stand's default weight; give --mass-kg" in (
         capsys.readouterr().out
     )
@@ -67,18 +67,18 @@ def test_import_stand_file_parameters_are_stored(light_csv: Path, tmp_path: Path
     stand.write_text(
         '[weight]\ndefault = "light"\n[params.final]\nstiffness_n_m = 50000.0\n', encoding="utf-8"
     )
-    assert main(["import", str(light_csv), "--stand", str(stand), "-o", str(rec)]) == 0
+    assert main(["import", str(light_csv), "--stand", str(stand), "-o", str(rec), "--force"]) == 0
     assert f"weight 3.096 kg (default weight of {stand})" in capsys.readouterr().out
     stored = open_recording(rec).metadata.stand_config
     assert stored["params"]["final"]["stiffness_n_m"] == 50000.0
     assert _replay(capsys, str(rec))["mass_kg"] == 3.096
-    assert main(["import", str(light_csv), "--mass-kg", "0", "-o", str(rec)]) == 2
+    assert main(["import", str(light_csv), "--mass-kg", "0", "-o", str(rec), "--force"]) == 2
     assert "--mass-kg must be > 0 kg, got 0" in capsys.readouterr().err
 
 
 def test_diagnose_takes_the_mass_as_replay_does(light_csv: Path, tmp_path: Path, capsys):
     rec = tmp_path / "light.mcap"
-    assert main(["import", str(light_csv), "--mass-kg", "3.096", "-o", str(rec)]) == 0
+    assert main(["import", str(light_csv), "--mass-kg", "3.096", "-o", str(rec), "--force"]) == 0
     stored = open_recording(rec).metadata.stand_config
     assert _mass_of(rec, stored, None, None) == (3.096, "stored in the recording")
     assert _mass_of(rec, stored, 5.0, None) == (5.0, "--mass-kg")
@@ -92,7 +92,7 @@ def test_tdms_import_stores_the_mass_too(tmp_path: Path, capsys):
 
     src, rec = tmp_path / "legacy.tdms", tmp_path / "legacy.h5"
     _tdms(src)
-    assert main(["import", str(src), *MAP, "--mass-kg", "3.096", "-o", str(rec)]) == 0
+    assert main(["import", str(src), *MAP, "--mass-kg", "3.096", "-o", str(rec), "--force"]) == 0
     assert "weight 3.096 kg (--mass-kg)" in capsys.readouterr().out
     stored = open_recording(rec).metadata.stand_config
     assert stored["weights_kg"][stored["weight"]["default"]] == 3.096

@@ -56,7 +56,7 @@ def test_simulate_mcap_hdf5_mcap_dataframe_is_lossless(simulated_mcap: Path, tmp
     assert df.attrs["units"]["F_N"] == "N" and df.attrs["units"]["u_mm"] == "mm"
     meta = last.metadata
     assert meta.backend is Backend.SIMULATE
-    assert meta.signal == preset.signal.to_dict()
+    assert meta.signal == {**preset.signal.to_dict(), "situation": "11"}  # as run stores it
     assert config_from_dict(meta.stand_config, "stored").stand_params("final") == (
         config.stand_params("final")
     )

@@ -223,7 +223,11 @@ def stand_file(tmp_path: Path) -> Path:
             "gain_error = 0.9 is outside its admissible range [-0.5, 0.5]",
         ),
         (["--slack-max-s", "0"], ExitCode.USAGE, "slack_max_s must be > 0"),
-        (["-o", "no/such/dir/x.mcap"], ExitCode.USAGE, "no/such/dir: no such directory"),
+        (
+            ["-o", "no/such/dir/x.mcap"],
+            ExitCode.USAGE,
+            "no/such/dir/x.mcap: cannot write: no such folder no/such/dir",
+        ),
     ],
 )
 def test_refused_or_bad_before_anything_starts(
