@@ -39,6 +39,7 @@ RECORDING_SETS = ("moderate", "gentle", "brisk", "paper")
 MASSES_KG = (3.096, 8.131)
 
 LABEL = "labstand diagnose-check"
+_WORDS = {2: "two", 3: "three"}
 
 
 def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -195,7 +196,7 @@ def _pairs(args: argparse.Namespace) -> list[tuple[str, ...]]:
                 or not set(names) <= set(OTHER_EFFECTS)
             ):
                 raise CommandError(
-                    f"{flag}: {text!r} is not {size} different effects joined by '+' "
+                    f"{flag}: {text!r} is not {_WORDS[size]} different effects joined by '+' "
                     f"(known: {', '.join(OTHER_EFFECTS)})",
                     ExitCode.USAGE,
                 )
