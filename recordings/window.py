@@ -17,9 +17,12 @@ from __future__ import annotations
 
 import bisect
 import logging
+import mmap
+import os
+import struct
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, BinaryIO
 
 import numpy as np
 from numpy.typing import NDArray
@@ -139,15 +142,17 @@ def _finish(
 
 def _mcap_window(path: Path, start_s: float | None, end_s: float | None) -> Window:
     from mcap.exceptions import McapError
-    from mcap.reader import make_reader
+    from mcap.reader import SeekingReader
 
     from recordings.mcap_writer import COMMAND_CODEC, DRIVE_CODEC, GAUGE_CODEC, METADATA_NAME
+    from recordings.mcapcheck import MAX_CHUNK_BYTES
     from recordings.proto import EVENT, parse
 
     where = str(path)
     try:
         with path.open("rb") as f:
-            reader = make_reader(f)
+            _check_mcap_layout(f, where)
+            reader = SeekingReader(f, validate_crcs=True, record_size_limit=MAX_CHUNK_BYTES)
             if reader.get_summary() is None:
                 raise _FallbackError("no summary section")
             meta_json = next(
@@ -192,11 +197,24 @@ def _mcap_window(path: Path, start_s: float | None, end_s: float | None) -> Wind
             streams["events"] = np.array(
                 [(e.t_ns, e.kind, e.text) for e in events], dtype=EVENTS_DTYPE
             ).reshape(len(events))
-    except WindowError:
+    except RecordingError:
         raise
-    except (McapError, EOFError, ValueError, KeyError) as err:
+    # what the seeking reader may still raise inside a chunk: the walk says what is wrong
+    except (McapError, EOFError, ValueError, KeyError, struct.error, OverflowError) as err:
         raise _FallbackError(f"{type(err).__name__}: {err}") from err
     return _finish(path, meta, streams, (lo, hi), span)
+
+
+def _check_mcap_layout(f: BinaryIO, where: str) -> None:
+    """The MCAP layout check of every read path; a file it finds cut goes to the walk."""
+    from recordings.mcapcheck import check_layout
+
+    if os.fstat(f.fileno()).st_size < 16:
+        raise _FallbackError("shorter than an MCAP header")
+    with mmap.mmap(f.fileno(), 0, access=mmap.ACCESS_READ) as data:
+        layout = check_layout(data, where)  # type: ignore[arg-type]  # mmap reads as bytes
+        if not layout.intact:
+            raise _FallbackError(layout.problem)
 
 
 def _as(fields: Any, dtype: np.dtype[Any]) -> NDArray[np.void]:
@@ -208,42 +226,36 @@ def _as(fields: Any, dtype: np.dtype[Any]) -> NDArray[np.void]:
 
 
 def _hdf5_window(path: Path, start_s: float | None, end_s: float | None) -> Window:
-    import h5py
+    from recordings.hdf5io import checked_hdf5
 
     where = str(path)
-    try:
-        with h5py.File(path, "r") as h5:
-            meta = RecordingMetadata.from_json(h5.attrs["metadata_json"], where)
-            g = h5["gauges"]
-            if len(g) == 0:
-                raise _FallbackError("no gauge samples")
-            span = (int(g[0]["t_ns"]), int(g[-1]["t_ns"]))
-            _check(where, start_s, end_s, span)
-            lo, hi = _bounds(start_s, end_s, span)
-            streams: dict[str, Any] = {}
-            for name, dtype in (
-                ("gauges", GAUGES_DTYPE),
-                ("command", COMMAND_DTYPE),
-                ("drive", DRIVE_DTYPE),
-            ):
-                ds = h5[name]
-                rows = range(len(ds))
+    with checked_hdf5(path) as h5:  # the same checks as a whole read: links, shapes, sizes
+        ds = h5.datasets
+        g = ds["gauges"]
+        if len(g) == 0:
+            raise _FallbackError("no gauge samples")
+        span = (int(g[0]["t_ns"]), int(g[-1]["t_ns"]))
+        _check(where, start_s, end_s, span)
+        lo, hi = _bounds(start_s, end_s, span)
+        streams: dict[str, Any] = {}
+        for name, dtype in (
+            ("gauges", GAUGES_DTYPE),
+            ("command", COMMAND_DTYPE),
+            ("drive", DRIVE_DTYPE),
+        ):
+            rows = range(len(ds[name]))
 
-                def t_at(i: int, ds: Any = ds) -> int:
-                    return int(ds[i]["t_ns"])
+            def t_at(i: int, d: Any = ds[name]) -> int:
+                return int(d[i]["t_ns"])
 
-                a = bisect.bisect_left(rows, lo, key=t_at)
-                b = bisect.bisect_right(rows, hi, key=t_at)
-                part = np.asarray(ds[a:b]) if b > a else np.empty(0, ds.dtype)
-                streams[name] = _as(part, dtype)
-            e = h5["events"][...]
-            events = np.empty(len(e), dtype=EVENTS_DTYPE)
-            events["t_ns"] = e["t_ns"]
-            for key in ("kind", "text"):
-                events[key] = [v.decode() if isinstance(v, bytes) else str(v) for v in e[key]]
-            streams["events"] = _slice(events, lo, hi)
-    except WindowError:
-        raise
-    except (OSError, KeyError, ValueError, TypeError) as err:
-        raise _FallbackError(f"{type(err).__name__}: {err}") from err
-    return _finish(path, meta, streams, (lo, hi), span)
+            a = bisect.bisect_left(rows, lo, key=t_at)
+            b = bisect.bisect_right(rows, hi, key=t_at)
+            part = np.asarray(ds[name][a:b]) if b > a else np.empty(0, ds[name].dtype)
+            streams[name] = _as(part, dtype)
+        e = ds["events"][...]
+        events = np.empty(len(e), dtype=EVENTS_DTYPE)
+        events["t_ns"] = e["t_ns"]
+        for key in ("kind", "text"):
+            events[key] = [v.decode() if isinstance(v, bytes) else str(v) for v in e[key]]
+        streams["events"] = _slice(events, lo, hi)
+    return _finish(path, h5.metadata, streams, (lo, hi), span)
