@@ -40,7 +40,7 @@ from recordings.proto import DRIVE_STATE, EVENT, parse
 from recordings.recording import Recording
 from recordings.schema import DRIVE_DTYPE, RecordingMetadata
 
-__all__ = ["read_mcap"]
+__all__ = ["check_chunks", "read_mcap"]
 
 log = logging.getLogger(__name__)
 
@@ -183,21 +183,7 @@ def _walk_file(path: Path, salvage: bool) -> _Walk:
             walk.chunks += 1  # e.g. the /gauges/plot chunks: not needed, not decompressed
             pos += _RECORD.size + length
             continue
-        try:
-            walk.record(opcode, body)
-        # OverflowError: a length field near 2**64 handed to BytesIO.read or a slice
-        except (struct.error, ValueError, UnicodeDecodeError, McapError, OverflowError) as err:
-            if isinstance(err, CorruptRecordingError):
-                raise
-            if isinstance(err, EndOfFile):
-                detail = "it ends before its fields do"
-            elif isinstance(err, OverflowError):
-                detail = "a length field in it is larger than any file"
-            else:
-                detail = one_line(str(err))
-            raise CorruptRecordingError(
-                f"{where}: record {opcode:#04x} at byte {pos} does not decode: {detail}"
-            ) from err
+        _decode(walk, opcode, body, pos)
         pos += _RECORD.size + length
         if opcode == _DATA_END:
             ended = True
@@ -206,6 +192,36 @@ def _walk_file(path: Path, salvage: bool) -> _Walk:
     if not intact:
         _truncated(walk, pos, size, ended)
     return walk
+
+
+def _decode(walk: _Walk, opcode: int, body: memoryview, pos: int) -> None:
+    """One top-level record into the walk; what does not decode, as CorruptRecordingError."""
+    try:
+        walk.record(opcode, body)
+    # OverflowError: a length field near 2**64 handed to BytesIO.read or a slice
+    except (struct.error, ValueError, UnicodeDecodeError, McapError, OverflowError) as err:
+        if isinstance(err, CorruptRecordingError):
+            raise
+        if isinstance(err, EndOfFile):
+            detail = "it ends before its fields do"
+        elif isinstance(err, OverflowError):
+            detail = "a length field in it is larger than any file"
+        else:
+            detail = one_line(str(err))
+        raise CorruptRecordingError(
+            f"{walk.where}: record {opcode:#04x} at byte {pos} does not decode: {detail}"
+        ) from err
+
+
+def check_chunks(chunks: list[tuple[int, bytes]], where: str) -> None:
+    """The whole read's checks of chunk records (offset in the file, the record's bytes).
+
+    Decompression, CRC and inner records, for the window reader, which hands those chunks
+    to the ``mcap`` package's reader (it checks less).
+    """
+    for offset, record in chunks:
+        walk = _Walk(where, salvage=False)
+        _decode(walk, _CHUNK, memoryview(record)[_RECORD.size :], offset)
 
 
 def _only_skipped_channels(view: memoryview, pos: int, walk: _Walk) -> bool:

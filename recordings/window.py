@@ -27,8 +27,9 @@ from typing import Any, BinaryIO
 import numpy as np
 from numpy.typing import NDArray
 
-from recordings.base import EVENTS_DTYPE
+from recordings.base import EVENTS_DTYPE, check_stream
 from recordings.errors import RecordingError
+from recordings.mcapcheck import McapLayout
 from recordings.recording import Recording, open_recording
 from recordings.schema import COMMAND_DTYPE, DRIVE_DTYPE, GAUGES_DTYPE, RecordingMetadata
 
@@ -151,7 +152,7 @@ def _mcap_window(path: Path, start_s: float | None, end_s: float | None) -> Wind
     where = str(path)
     try:
         with path.open("rb") as f:
-            _check_mcap_layout(f, where)
+            layout = _check_mcap_layout(f, where)
             reader = SeekingReader(f, validate_crcs=True, record_size_limit=MAX_CHUNK_BYTES)
             if reader.get_summary() is None:
                 raise _FallbackError("no summary section")
@@ -178,6 +179,7 @@ def _mcap_window(path: Path, start_s: float | None, end_s: float | None) -> Wind
             span = (int(head["t_ns"][0]), int(tail["t_ns"][-1]))
             _check(where, start_s, end_s, span)
             lo, hi = _bounds(start_s, end_s, span)
+            _check_window_chunks(f, layout, t0 + lo, t0 + hi, where)
             streams: dict[str, Any] = {}
             for name, topic, codec in (
                 ("gauges", "/gauges", GAUGE_CODEC),
@@ -188,11 +190,15 @@ def _mcap_window(path: Path, start_s: float | None, end_s: float | None) -> Wind
                     reader.iter_messages(topics=[topic], ending_before=t0 + lo, reverse=True), None
                 )
                 data = ([before[2].data] if before else []) + batches(topic, lo, hi)
-                streams[name] = _slice(codec.decode_many(data, where), lo, hi)
+                decoded = codec.decode_many(data, where)
+                check_stream(where, name, decoded)  # all it read, not only the window's part
+                streams[name] = _slice(decoded, lo, hi)
             drive = DRIVE_CODEC.decode_fast(batches("/drive", lo, hi))
             if drive is None:
                 raise _FallbackError("drive polls not in the fixed layout")
-            streams["drive"] = _slice(_as(drive, DRIVE_DTYPE), lo, hi)
+            drive_rows = _as(drive, DRIVE_DTYPE)
+            check_stream(where, "drive", drive_rows, strict=False)
+            streams["drive"] = _slice(drive_rows, lo, hi)
             events = [parse(EVENT, d, where) for d in batches("/events", lo, hi)]
             streams["events"] = np.array(
                 [(e.t_ns, e.kind, e.text) for e in events], dtype=EVENTS_DTYPE
@@ -205,7 +211,7 @@ def _mcap_window(path: Path, start_s: float | None, end_s: float | None) -> Wind
     return _finish(path, meta, streams, (lo, hi), span)
 
 
-def _check_mcap_layout(f: BinaryIO, where: str) -> None:
+def _check_mcap_layout(f: BinaryIO, where: str) -> McapLayout:
     """The MCAP layout check of every read path; a file it finds cut goes to the walk."""
     from recordings.mcapcheck import check_layout
 
@@ -215,6 +221,27 @@ def _check_mcap_layout(f: BinaryIO, where: str) -> None:
         layout = check_layout(data, where)  # type: ignore[arg-type]  # mmap reads as bytes
         if not layout.intact:
             raise _FallbackError(layout.problem)
+    return layout
+
+
+def _check_window_chunks(f: BinaryIO, layout: McapLayout, lo: int, hi: int, where: str) -> None:
+    """The whole read's chunk checks on the chunks the window reads (and the edges').
+
+    Those overlapping ``lo … hi`` (log times), the one before them (its batch starts
+    before the window), and the first and last (the span's edges).
+    """
+    from recordings.mcap_reader import check_chunks
+
+    chunks = layout.chunks
+    if not chunks:
+        return
+    hit = [i for i, c in enumerate(chunks) if c.end_ns >= lo and c.start_ns <= hi]
+    picked = set(hit) | {0, len(chunks) - 1} | ({hit[0] - 1} if hit and hit[0] else set())
+    wanted = []
+    for i in sorted(picked):
+        f.seek(chunks[i].offset)  # inside the file: the layout check saw the whole record
+        wanted.append((chunks[i].offset, f.read(chunks[i].length)))
+    check_chunks(wanted, where)
 
 
 def _as(fields: Any, dtype: np.dtype[Any]) -> NDArray[np.void]:
