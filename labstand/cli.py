@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING, Any, NoReturn
 
 from drivers.limits import LimitError
 from labstand.errors import CommandError, ExitCode
+from labstand.interrupts import Terminated, terminate_as_exception
 from recordings.errors import RecordingError
 from sim.errors import SimulationError
 
@@ -123,6 +124,7 @@ _PREFIXES = {
     ExitCode.REFUSED: "refused",
     ExitCode.ESTOP: "e-stop",
     ExitCode.INTERRUPTED: "interrupted",
+    ExitCode.TERMINATED: "terminated",
 }
 
 
@@ -168,6 +170,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         level=logging.DEBUG if args.verbose else logging.WARNING,
         format="%(levelname)s %(name)s: %(message)s",
     )
+    terminate_as_exception()
     try:
         code: int = args.func(args)
     except BrokenPipeError:
@@ -176,6 +179,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, sys.stdout.fileno())
         return ExitCode.OK
+    except Terminated:
+        print("labstand: terminated (SIGTERM)", file=sys.stderr)
+        return ExitCode.TERMINATED
     except KeyboardInterrupt:
         print("labstand: interrupted", file=sys.stderr)
         return ExitCode.INTERRUPTED
