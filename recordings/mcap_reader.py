@@ -213,15 +213,17 @@ def _decode(walk: _Walk, opcode: int, body: memoryview, pos: int) -> None:
         ) from err
 
 
-def check_chunks(chunks: list[tuple[int, bytes]], where: str) -> None:
+def check_chunks(chunks: list[tuple[int, bytes]], where: str) -> dict[int, Channel]:
     """The whole read's checks of chunk records (offset in the file, the record's bytes).
 
     Decompression, CRC and inner records, for the window reader, which hands those chunks
-    to the ``mcap`` package's reader (it checks less).
+    to the ``mcap`` package's reader (it checks less). Returns the channels the chunks
+    define, for the caller to hold against the summary's.
     """
+    walk = _Walk(where, salvage=False)
     for offset, record in chunks:
-        walk = _Walk(where, salvage=False)
         _decode(walk, _CHUNK, memoryview(record)[_RECORD.size :], offset)
+    return walk.channels
 
 
 def _only_skipped_channels(view: memoryview, pos: int, walk: _Walk) -> bool:

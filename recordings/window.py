@@ -28,7 +28,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from recordings.base import EVENTS_DTYPE, check_stream
-from recordings.errors import RecordingError
+from recordings.errors import CorruptRecordingError, RecordingError
 from recordings.mcapcheck import McapLayout
 from recordings.recording import Recording, open_recording
 from recordings.schema import COMMAND_DTYPE, DRIVE_DTYPE, GAUGES_DTYPE, RecordingMetadata
@@ -179,7 +179,8 @@ def _mcap_window(path: Path, start_s: float | None, end_s: float | None) -> Wind
             span = (int(head["t_ns"][0]), int(tail["t_ns"][-1]))
             _check(where, start_s, end_s, span)
             lo, hi = _bounds(start_s, end_s, span)
-            _check_window_chunks(f, layout, t0 + lo, t0 + hi, where)
+            channels = _check_window_chunks(f, layout, t0 + lo, t0 + hi, where)
+            _same_channels(channels, reader.get_summary(), where)
             streams: dict[str, Any] = {}
             for name, topic, codec in (
                 ("gauges", "/gauges", GAUGE_CODEC),
@@ -224,7 +225,21 @@ def _check_mcap_layout(f: BinaryIO, where: str) -> McapLayout:
     return layout
 
 
-def _check_window_chunks(f: BinaryIO, layout: McapLayout, lo: int, hi: int, where: str) -> None:
+def _same_channels(data: dict[int, Any], summary: Any, where: str) -> None:
+    """The channels the data defines must be the summary's (the seeking reader's)."""
+    for cid, channel in data.items():
+        known = summary.channels.get(cid) if summary is not None else None
+        mine = (channel.topic, channel.schema_id, channel.message_encoding)
+        if known is None or (known.topic, known.schema_id, known.message_encoding) != mine:
+            raise CorruptRecordingError(
+                f"{where}: channel {cid} ({channel.topic!r}) differs between the data and "
+                f"the summary; `labstand recover {where} -o FIXED.mcap` rebuilds the summary"
+            )
+
+
+def _check_window_chunks(
+    f: BinaryIO, layout: McapLayout, lo: int, hi: int, where: str
+) -> dict[int, Any]:
     """The whole read's chunk checks on the chunks the window reads (and the edges').
 
     Those overlapping ``lo … hi`` (log times), the one before them (its batch starts
@@ -234,14 +249,14 @@ def _check_window_chunks(f: BinaryIO, layout: McapLayout, lo: int, hi: int, wher
 
     chunks = layout.chunks
     if not chunks:
-        return
+        return {}
     hit = [i for i, c in enumerate(chunks) if c.end_ns >= lo and c.start_ns <= hi]
     picked = set(hit) | {0, len(chunks) - 1} | ({hit[0] - 1} if hit and hit[0] else set())
     wanted = []
     for i in sorted(picked):
         f.seek(chunks[i].offset)  # inside the file: the layout check saw the whole record
         wanted.append((chunks[i].offset, f.read(chunks[i].length)))
-    check_chunks(wanted, where)
+    return check_chunks(wanted, where)
 
 
 def _as(fields: Any, dtype: np.dtype[Any]) -> NDArray[np.void]:

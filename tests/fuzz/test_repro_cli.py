@@ -53,3 +53,18 @@ def test_every_input_is_refused_in_one_line_exit_2(tmp_path: Path) -> None:
         found = pool.map(lambda ic: _problem(ic[1], tmp_path, seed, ic[0]), enumerate(cases))
         problems = [p for p in found if p is not None]
     assert not problems, f"{len(problems)} of {len(cases)} cases:\n" + "\n".join(problems)
+
+
+def test_every_cut_inside_the_mcap_header_is_refused_by_cat(tmp_path: Path) -> None:
+    """The README's `head -c 9 any.mcap`: `cat` said `[Errno 22] Invalid argument`, exit 1."""
+    (tmp_path / "seeds").mkdir()
+    data = corpus.write_seeds(tmp_path / "seeds")[".mcap"].read_bytes()
+    problems = []
+    for size in (1, 8, 9, 12, 20, 40):
+        path = tmp_path / f"t{size}.mcap"
+        path.write_bytes(data[:size])
+        got = repro_cases.run_case(path, ["cat", str(path)], tmp_path)
+        lines = got.stderr.splitlines()
+        if got.returncode != 2 or len(lines) != 1 or str(path) not in lines[0]:
+            problems.append(f"{size} bytes: exit {got.returncode}: {got.stderr[-300:]}")
+    assert not problems, problems
