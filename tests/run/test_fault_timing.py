@@ -7,12 +7,18 @@ injects the faults (``--sim-fault``, sim/hardware/faults.py).
 
 from __future__ import annotations
 
+import contextlib
+import os
+import signal
+import time
 from collections.abc import Callable
 from pathlib import Path
 
+import pytest
+
 from labstand.errors import ExitCode
 from recordings import Recording, open_recording
-from tests.run.conftest import SHORT, Outcome
+from tests.run.conftest import SHORT, Outcome, RunProcess
 
 #: The bounds docs/acquisition.md states: the silence rule's 0.25 s plus one pass and the
 #: wait for a fresh poll; the drive's 0.5 s rule plus a poll period, two passes and slack.
@@ -53,3 +59,26 @@ def test_gauge_silence_is_judged_while_the_drive_link_is_retried(
     last_sample_s = float(rec.gauges["t_ns"][-1]) / 1e9
     assert text.startswith("the gauge stream has been silent"), text
     assert 0.25 <= t_estop - last_sample_s <= GAUGE_SILENCE_BOUND_S, (t_estop, last_sample_s)
+
+
+@pytest.mark.parametrize("how", [signal.SIGKILL, signal.SIGSTOP])
+def test_a_killed_or_stopped_stand_ends_in_one_line(tmp_path: Path, how: signal.Signals) -> None:
+    """The device layer's retries and warnings go to the log; the terminal gets the end."""
+    out = tmp_path / "killed.mcap"
+    run = RunProcess([*SHORT, "-o", str(out)])
+    try:
+        run.wait_endpoints()
+        deadline = time.monotonic() + 30
+        while not out.exists() and time.monotonic() < deadline:
+            time.sleep(0.02)
+        time.sleep(0.5)
+        os.kill(run.sim_pid, how)
+        result = run.finish()
+    finally:
+        run.kill()
+        if how == signal.SIGSTOP:
+            with contextlib.suppress(ProcessLookupError):
+                os.kill(run.sim_pid, signal.SIGKILL)
+    assert result.code == ExitCode.ESTOP, result.err
+    lines = result.err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("labstand: e-stop: "), result.err
