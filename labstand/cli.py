@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING, Any, NoReturn
 
 from drivers.limits import LimitError
 from labstand.errors import CommandError, ExitCode
-from labstand.interrupts import Terminated, terminate_as_exception
+from labstand.interrupts import Terminated, sigterm_raises
 from recordings.errors import RecordingError
 from sim.errors import SimulationError
 
@@ -170,9 +170,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         level=logging.DEBUG if args.verbose else logging.WARNING,
         format="%(levelname)s %(name)s: %(message)s",
     )
-    terminate_as_exception()
     try:
-        code: int = args.func(args)
+        with sigterm_raises():
+            code: int = args.func(args)
     except BrokenPipeError:
         # The reader went away (`labstand info X | head -1`): end quietly, as Unix tools
         # do; stdout goes to /dev/null so the interpreter's final flush cannot fail too.

@@ -20,10 +20,17 @@ def _raise_terminated(signum: int, frame: object) -> None:
     raise Terminated
 
 
-def terminate_as_exception() -> None:
-    """Make SIGTERM raise ``Terminated`` in the main thread (the CLI's start)."""
-    if threading.current_thread() is threading.main_thread():
-        signal.signal(signal.SIGTERM, _raise_terminated)
+@contextmanager
+def sigterm_raises() -> Iterator[None]:
+    """SIGTERM raises ``Terminated`` in the main thread, for the ``with`` block (a command)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGTERM, _raise_terminated)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
 
 
 class Interrupt(threading.Event):
