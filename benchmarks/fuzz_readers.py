@@ -1,12 +1,19 @@
 """Thousands of mutated files through every reader: how many read, are refused, or break.
 
-The cases are those of ``tests/fuzz/corpus.py`` (seeded: the same files on every run):
-valid MCAP, HDF5, CSV, TDMS and stand TOML files, each with one to three edits. Each
-case runs in a worker process (forked, so no start-up cost per case) with a memory cap;
-a case that does not answer within ``--timeout-s`` is a hang (the worker is killed and
-replaced), a worker that dies is a crash. Run from the repository's root::
+The cases are seeded (the same files on every run), from two generators:
+``tests/fuzz/corpus.py`` (``--strategies mutations``: valid MCAP, HDF5, CSV, TDMS and
+stand TOML files, each with one to three byte edits) and ``tests/fuzz/structural.py``
+(``structural``: cuts at MCAP records and HDF5 object headers, framing-consistent edits,
+checksum-valid files with wrong types, links, shapes and times, CSV/Parquet/TOML
+extremes, read through every read path: whole, salvaging, window, grid, rewrite);
+``all`` alternates them. Each case runs in a worker process (forked, so no start-up cost
+per case) with its address space capped at what it holds plus ``--memory-gib``: an
+allocation beyond it is a MemoryError, counted as a traceback. A case that does not
+answer within ``--timeout-s`` is a hang (the worker is killed and replaced), a worker
+that dies is a crash. Run from the repository's root::
 
     .venv/bin/python benchmarks/fuzz_readers.py [--cases 10000] [--seed 1] [--workers 2]
+        [--strategies all]
 
 Prints the counts: read fine, clean refusals (the package's error, one line naming the
 file), unclean refusals (the right type, but several lines or no file name),
@@ -31,7 +38,9 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # the corpus lives in tests/
 
-from tests.fuzz import corpus
+from recordings import RecordingError
+from sim.config import ConfigError
+from tests.fuzz import corpus, structural
 
 OUTCOMES = ("read", "refused", "unclean", "traceback", "hang", "crash")
 
@@ -44,22 +53,52 @@ def _cap_memory(extra_bytes: int) -> None:
     resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
 
 
-def _serve(conn: Connection, seeds: dict[str, bytes], seed: int, work: Path, memory: int) -> None:
+STRATEGIES = ("mutations", "structural", "all")
+
+
+def describe(seeds: dict[str, bytes], seed: int, index: int, work: Path, strategy: str) -> object:
+    """Write case ``index`` into ``work``; the case (its ``str`` says what was done)."""
+    if strategy == "mutations" or (strategy == "all" and index % 2 == 0):
+        return corpus.make_case(seeds, seed, index // (2 if strategy == "all" else 1), work)
+    return structural.make_case(seeds, seed, index // (2 if strategy == "all" else 1), work)
+
+
+def _judge(case: object) -> tuple[str, str]:
+    """(outcome, detail) of reading one case."""
+    if isinstance(case, structural.Case):
+        read, expected, path = (lambda: structural.read(case)), structural.EXPECTED, case.path
+    else:
+        assert isinstance(case, corpus.Case)
+        path = case.path
+        read, expected = (lambda: corpus.read(path)), (corpus.expected_error(path),)
+    try:
+        read()
+        return "read", ""
+    except expected as err:
+        message = str(err)
+        # a file's fault names the file; an option's (--encoding) or the grid's need not
+        named = str(path) in message or message.startswith("--")
+        named = named or not isinstance(err, RecordingError | ConfigError)
+        clean = "\n" not in message and named
+        return ("refused" if clean else "unclean"), message
+    except BaseException as err:  # MemoryError and RecursionError included
+        return "traceback", f"{type(err).__name__}: {err}"
+
+
+def _serve(
+    conn: Connection, seeds: dict[str, bytes], seed: int, work: Path, memory: int, strategy: str
+) -> None:
     """Worker: read case indexes, answer (index, outcome, detail)."""
     _cap_memory(memory)
     warnings.simplefilter("error")  # as pytest runs the readers: a warning is a failure
     logging.disable(logging.CRITICAL)  # the readers log salvaged files' repairs
     while (index := conn.recv()) is not None:
-        case = corpus.make_case(seeds, seed, index, work)
         try:
-            corpus.read(case.path)
-            outcome, detail = "read", ""
-        except corpus.expected_error(case.path) as err:
-            message = str(err)
-            clean = "\n" not in message and str(case.path) in message
-            outcome, detail = ("refused" if clean else "unclean"), message
-        except BaseException as err:  # MemoryError and RecursionError included
-            outcome, detail = "traceback", f"{type(err).__name__}: {err}"
+            case = describe(seeds, seed, index, work, strategy)
+        except Exception as err:  # the generator's own failure: not the readers'
+            conn.send((index, "traceback", f"generating: {type(err).__name__}: {err}"[:300]))
+            continue
+        outcome, detail = _judge(case)
         conn.send((index, outcome, detail[:300]))
 
 
@@ -85,20 +124,32 @@ class _Worker:
         self.conn.close()
 
 
-def run(cases: int, seed: int, workers: int, timeout_s: float, memory_gib: float) -> int:
+def run(
+    cases: int,
+    seed: int,
+    workers: int,
+    timeout_s: float,
+    memory_gib: float,
+    strategy: str = "all",
+) -> int:
     """Run the cases; print the counts; return 1 if any case broke."""
     top = Path(tempfile.mkdtemp(prefix="fuzz-readers-"))
     try:
-        return _run(top, cases, seed, workers, timeout_s, memory_gib)
+        return _run(top, cases, seed, workers, timeout_s, memory_gib, strategy)
     finally:
         shutil.rmtree(top, ignore_errors=True)
 
 
 def _run(
-    top: Path, cases: int, seed: int, workers: int, timeout_s: float, memory_gib: float
+    top: Path,
+    cases: int,
+    seed: int,
+    workers: int,
+    timeout_s: float,
+    memory_gib: float,
+    strategy: str,
 ) -> int:
-    paths = corpus.write_seeds(top)
-    seeds = {kind: path.read_bytes() for kind, path in paths.items()}
+    seeds = structural.write_seeds(top)  # the corpus's seeds and a Parquet one
     ctx = multiprocessing.get_context("fork")
     generation = 0
 
@@ -107,7 +158,7 @@ def _run(
         generation += 1
         work = top / f"w{generation}"
         work.mkdir()
-        return _Worker(ctx, (seeds, seed, work, int(memory_gib * 2**30)))
+        return _Worker(ctx, (seeds, seed, work, int(memory_gib * 2**30), strategy))
 
     counts: Counter[str] = Counter()
     listed: dict[str, list[str]] = {k: [] for k in OUTCOMES}
@@ -120,8 +171,10 @@ def _run(
     def record(index: int, outcome: str, detail: str) -> None:
         counts[outcome] += 1
         if outcome not in ("read", "refused") and len(listed[outcome]) < 5:
-            described = corpus.make_case(seeds, seed, index, top)  # the parent's own copy
-            listed[outcome].append(f"{described}: {detail}")
+            spare = top / "described"
+            spare.mkdir(exist_ok=True)
+            described = describe(seeds, seed, index, spare, strategy)  # the parent's own copy
+            listed[outcome].append(f"case {index}, {described}: {detail}")
 
     while any(w.case is not None for w in pool):
         busy = [w for w in pool if w.case is not None]
@@ -146,7 +199,7 @@ def _run(
         worker.conn.send(None)
         worker.process.join()
     elapsed = time.perf_counter() - t0
-    _report(cases, seed, counts, listed, elapsed)
+    _report(cases, seed, counts, listed, elapsed, strategy)
     return 1 if any(counts[k] for k in ("unclean", "traceback", "hang", "crash")) else 0
 
 
@@ -156,9 +209,17 @@ def _replace(worker: _Worker, start: Callable[[], _Worker]) -> _Worker:
 
 
 def _report(
-    cases: int, seed: int, counts: Counter[str], listed: dict[str, list[str]], elapsed: float
+    cases: int,
+    seed: int,
+    counts: Counter[str],
+    listed: dict[str, list[str]],
+    elapsed: float,
+    strategy: str,
 ) -> None:
-    print(f"{cases} cases (seed {seed}) in {elapsed:.1f} s ({cases / elapsed:.0f} cases/s)")
+    print(
+        f"{cases} cases ({strategy}, seed {seed}) in {elapsed:.1f} s "
+        f"({cases / elapsed:.0f} cases/s)"
+    )
     labels = {
         "read": "read fine",
         "refused": "clean refusals",
@@ -180,8 +241,11 @@ def main() -> int:
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--timeout-s", type=float, default=20.0, help="per case")
     parser.add_argument("--memory-gib", type=float, default=2.0, help="per worker, extra")
+    parser.add_argument("--strategies", choices=STRATEGIES, default="all")
     args = parser.parse_args()
-    return run(args.cases, args.seed, args.workers, args.timeout_s, args.memory_gib)
+    return run(
+        args.cases, args.seed, args.workers, args.timeout_s, args.memory_gib, args.strategies
+    )
 
 
 if __name__ == "__main__":

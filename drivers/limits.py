@@ -13,6 +13,27 @@ class LimitError(ValueError):
     """A drive command lies beyond the stand's limits; nothing was moved."""
 
 
+class InvalidSignalError(ValueError):
+    """A signal value that is no valid value of its field (NaN, ≤ 0, ...): bad input.
+
+    Not a LimitError: a limit refuses a motion the drive cannot make (exit 3); this
+    refuses a value that describes no motion at all (exit 2).
+    """
+
+
+#: The drive's profile clock (Pr 20.34, 32 bits of 10 µs) wraps after 2³¹ × 10 µs =
+#: 21 474.8 s (5.96 h): a profile must end before it does.
+PROFILE_CLOCK_MAX_S = 2**31 * 1e-5
+#: Dwell times are written in µs to 32-bit parameters (Pr 20.26, 20.27): at most 2147 s.
+DWELL_MAX_S = (2**31 - 1) * 1e-6
+#: Frequencies are written in µHz (Pr 20.23): below 1 mHz the written value is off by
+#: more than 0.1 %, and a cycle lasts over 16 min.
+FREQUENCY_MIN_HZ = 1e-3
+#: The planners build a few pieces per cycle and the drive's program steps through them:
+#: beyond 10⁵ cycles the plan takes seconds and the simulated drive stalls loading it.
+CYCLES_MAX = 100_000
+
+
 @dataclass(frozen=True)
 class DriveLimits:
     """Limits of the linear drive, SI units.

@@ -30,14 +30,29 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
-from drivers.limits import DriveLimits, LimitError
+from drivers.limits import (
+    CYCLES_MAX,
+    DWELL_MAX_S,
+    FREQUENCY_MIN_HZ,
+    PROFILE_CLOCK_MAX_S,
+    DriveLimits,
+    InvalidSignalError,
+    LimitError,
+)
 
 if TYPE_CHECKING:
     from scipy.interpolate import PPoly
 
 FloatArray = NDArray[np.float64]
 
-__all__ = ["DriveProfile", "Shape", "SignalSpec", "plan_motion"]
+__all__ = [
+    "DriveProfile",
+    "Shape",
+    "SignalSpec",
+    "check_duration",
+    "check_values",
+    "plan_motion",
+]
 
 
 class Shape(StrEnum):
@@ -166,16 +181,52 @@ class DriveProfile:
         return total / math.prod(widths)
 
 
-def _check_spec(spec: SignalSpec, limits: DriveLimits) -> None:
-    limits.check_amplitude(spec.amplitude_m)
+def check_values(spec: SignalSpec) -> None:
+    """Raise InvalidSignalError for a value that describes no motion (NaN, ≤ 0, ...)."""
+    if not (math.isfinite(spec.amplitude_m) and spec.amplitude_m > 0):
+        raise InvalidSignalError(f"amplitude must be > 0 mm, got {spec.amplitude_m * 1e3:g} mm")
     if not (math.isfinite(spec.frequency_hz) and spec.frequency_hz > 0):
-        raise LimitError(f"frequency must be > 0 Hz, got {spec.frequency_hz:g} Hz")
+        raise InvalidSignalError(f"frequency must be > 0 Hz, got {spec.frequency_hz:g} Hz")
     if spec.cycles < 1:
-        raise LimitError(f"cycles must be ≥ 1, got {spec.cycles}")
-    if spec.dwell_start_s < 0 or spec.dwell_end_s < 0:
-        raise LimitError("dwell times must be ≥ 0 s")
+        raise InvalidSignalError(f"cycles must be ≥ 1, got {spec.cycles}")
+    for name in ("dwell_start_s", "dwell_end_s"):
+        value = getattr(spec, name)
+        if not (math.isfinite(value) and value >= 0):
+            raise InvalidSignalError(f"{name} must be a finite number of s ≥ 0, got {value:g}")
     if spec.shape is Shape.TRAPEZOIDAL and not 0 < spec.ramp_fraction <= 0.5:
-        raise LimitError(f"ramp fraction must lie in (0, 0.5], got {spec.ramp_fraction:g}")
+        raise InvalidSignalError(f"ramp fraction must lie in (0, 0.5], got {spec.ramp_fraction:g}")
+
+
+def check_duration(spec: SignalSpec) -> None:
+    """Refuse (LimitError) what the drive's profile parameters and clock cannot hold.
+
+    Checked before planning: the planners loop over the cycles (10⁹ cycles never ended).
+    """
+    if spec.frequency_hz < FREQUENCY_MIN_HZ:
+        raise LimitError(
+            f"frequency {spec.frequency_hz:g} Hz is below the drive's {FREQUENCY_MIN_HZ:g} Hz "
+            "(Pr 20.23 holds µHz)"
+        )
+    if spec.cycles > CYCLES_MAX:
+        raise LimitError(f"{spec.cycles} cycles exceed the drive program's {CYCLES_MAX}")
+    for name in ("dwell_start_s", "dwell_end_s"):
+        if getattr(spec, name) > DWELL_MAX_S:
+            raise LimitError(
+                f"{name} {getattr(spec, name):g} s exceeds the drive's {DWELL_MAX_S:.0f} s "
+                "(a 32-bit parameter of µs)"
+            )
+    total_s = spec.dwell_start_s + spec.cycles / spec.frequency_hz + spec.dwell_end_s
+    if total_s >= PROFILE_CLOCK_MAX_S:
+        raise LimitError(
+            f"the motion lasts {total_s:.6g} s ({total_s / 3600:.3g} h); the drive's profile "
+            f"clock (Pr 20.34) wraps at {PROFILE_CLOCK_MAX_S:.0f} s (5.96 h)"
+        )
+
+
+def _check_spec(spec: SignalSpec, limits: DriveLimits) -> None:
+    check_values(spec)
+    limits.check_amplitude(spec.amplitude_m)
+    check_duration(spec)
 
 
 def _levels_ppoly(breaks: list[float], coeffs: list[tuple[float, float]]) -> PPoly:

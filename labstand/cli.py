@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING, Any, NoReturn
 
 from drivers.limits import LimitError
 from labstand.errors import CommandError, ExitCode, describe_os_error
+from labstand.interrupts import Terminated, sigterm_raises
 from labstand.stands import find_stand
 from labstand.targets import add_force, check_outputs
 from recordings.errors import RecordingError
@@ -133,6 +134,7 @@ _PREFIXES = {
     ExitCode.REFUSED: "refused",
     ExitCode.ESTOP: "e-stop",
     ExitCode.INTERRUPTED: "interrupted",
+    ExitCode.TERMINATED: "terminated",
 }
 
 
@@ -189,13 +191,17 @@ def main(argv: Sequence[str] | None = None) -> int:
         if getattr(args, "find_stand", False) and args.stand is None:
             args.stand, args.stand_origin = find_stand()
         check_outputs(args, getattr(args, "outputs", None) or {})  # before any work
-        code: int = args.func(args)
+        with sigterm_raises():
+            code: int = args.func(args)
     except BrokenPipeError:
         # The reader went away (`labstand info X | head -1`): end quietly, as Unix tools
         # do; stdout goes to /dev/null so the interpreter's final flush cannot fail too.
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, sys.stdout.fileno())
         return ExitCode.OK
+    except Terminated:
+        print("labstand: terminated (SIGTERM)", file=sys.stderr)
+        return ExitCode.TERMINATED
     except KeyboardInterrupt:
         print("labstand: interrupted", file=sys.stderr)
         return ExitCode.INTERRUPTED

@@ -4,6 +4,9 @@ from __future__ import annotations
 
 import html
 import json
+import os
+import shutil
+import tempfile
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
@@ -248,8 +251,29 @@ def _fmt(value: object, key: object = None) -> str:
 
 
 def write_report(directory: Path, traces: Sequence[Trace], result: Diagnosis) -> Path:
-    """Write index.html, its PNGs and result.json into directory; returns index.html."""
-    directory.mkdir(exist_ok=True)  # its parent was checked before the work
+    """Write index.html, its PNGs and result.json into directory; returns index.html.
+
+    Written into a hidden folder beside it and renamed at the end, so an interruption
+    (Ctrl-C, SIGTERM, a failed plot) leaves no partial report: a new directory appears
+    whole or not at all; into an existing one the files are moved one by one, each whole.
+    """
+    directory.parent.mkdir(parents=True, exist_ok=True)
+    work = Path(
+        tempfile.mkdtemp(prefix=f".{directory.name}.", suffix=".partial", dir=directory.parent)
+    )
+    try:
+        _write_into(work, traces, result)
+        if not directory.exists():
+            os.replace(work, directory)
+        else:
+            for item in sorted(work.iterdir()):
+                os.replace(item, directory / item.name)
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+    return directory / "index.html"
+
+
+def _write_into(directory: Path, traces: Sequence[Trace], result: Diagnosis) -> None:
     _residual_plot(directory / "residual.png", traces, result)
     _ranking_plot(directory / "ranking.png", result)
     _overlay_plot(directory / "overlay.png", traces, result)
@@ -294,6 +318,4 @@ bootstrap confidence {result.confidence:.2f}).</p>
 <h2>Fitted baseline</h2>{_table(result.baseline)}
 </body></html>
 """
-    index = directory / "index.html"
-    index.write_text(page, encoding="utf-8")
-    return index
+    (directory / "index.html").write_text(page, encoding="utf-8")

@@ -19,7 +19,8 @@ class ExitCode(IntEnum):
     USAGE = 2  # bad arguments or bad input files (argparse uses 2 as well)
     REFUSED = 3  # a command beyond the stand's limits: nothing moved
     ESTOP = 4  # a run ended in an emergency stop (recording closed and readable)
-    INTERRUPTED = 130  # Ctrl-C
+    INTERRUPTED = 130  # Ctrl-C (SIGINT)
+    TERMINATED = 143  # SIGTERM (128 + 15, as a shell reports a process it ended)
 
 
 class CommandError(Exception):

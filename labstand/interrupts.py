@@ -1,4 +1,8 @@
-"""Ctrl-C remembered as well as raised (for code that waits inside libraries)."""
+"""Ctrl-C remembered as well as raised (for code that waits inside libraries).
+
+SIGTERM is raised as ``Terminated`` (a KeyboardInterrupt), so every command ends it as it
+ends a Ctrl-C (cleanly) and says which it was: exit 143, "terminated".
+"""
 
 from __future__ import annotations
 
@@ -8,8 +12,39 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 
 
+class Terminated(KeyboardInterrupt):
+    """SIGTERM, raised in the main thread: handled wherever a Ctrl-C is, named apart."""
+
+
+def _raise_terminated(signum: int, frame: object) -> None:
+    raise Terminated
+
+
 @contextmanager
-def remembered_interrupt(raise_now: bool = True) -> Iterator[threading.Event]:
+def sigterm_raises() -> Iterator[None]:
+    """SIGTERM raises ``Terminated`` in the main thread, for the ``with`` block (a command)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGTERM, _raise_terminated)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+class Interrupt(threading.Event):
+    """A remembered Ctrl-C or SIGTERM: ``raise_it`` raises the one that came."""
+
+    terminated = False
+
+    def raise_it(self) -> None:
+        """Raise Terminated for a SIGTERM, KeyboardInterrupt for a Ctrl-C."""
+        raise Terminated if self.terminated else KeyboardInterrupt
+
+
+@contextmanager
+def remembered_interrupt(raise_now: bool = True) -> Iterator[Interrupt]:
     """Ctrl-C remembered as well as raised, for the ``with`` block (main thread only).
 
     A KeyboardInterrupt raised inside a library's own waiting (Dask starting workers or
@@ -20,18 +55,20 @@ def remembered_interrupt(raise_now: bool = True) -> Iterator[threading.Event]:
     construction it interrupted failed in its ``__del__`` at exit, a traceback after
     "labstand: interrupted").
     """
-    event = threading.Event()
+    event = Interrupt()
     if threading.current_thread() is not threading.main_thread():
         yield event
         return
 
     def on_interrupt(signum: int, frame: object) -> None:
+        event.terminated = event.terminated or signum == signal.SIGTERM
         event.set()
         if raise_now:
-            raise KeyboardInterrupt
+            event.raise_it()
 
-    previous = signal.signal(signal.SIGINT, on_interrupt)
+    previous = {s: signal.signal(s, on_interrupt) for s in (signal.SIGINT, signal.SIGTERM)}
     try:
         yield event
     finally:
-        signal.signal(signal.SIGINT, previous)
+        for s, handler in previous.items():
+            signal.signal(s, handler)

@@ -26,6 +26,7 @@ from recordings.schema import (
     COMMAND_DTYPE,
     DRIVE_DTYPE,
     GAUGES_DTYPE,
+    MAX_RUN_TIME_NS,
     Block,
     RecordingMetadata,
     as_block,
@@ -80,6 +81,15 @@ def check_stream(where: str, stream: str, block: NDArray[np.void], strict: bool 
                 f"{where}: {stream}.{name} does not increase at sample {i + 1} "
                 f"({int(values[i])} then {int(values[i + 1])})"
             )
+
+
+def _check_time_range(where: str, stream: str, first_ns: int, last_ns: int) -> None:
+    """Refuse times beyond ±MAX_RUN_TIME_NS (104 days) of the start, for every format."""
+    if not (first_ns >= -MAX_RUN_TIME_NS and last_ns <= MAX_RUN_TIME_NS):
+        raise InvalidDataError(
+            f"{where}: cannot write {stream}.t_ns {first_ns} … {last_ns} ns: "
+            f"beyond ±{MAX_RUN_TIME_NS} ns (104 days) of the start"
+        )
 
 
 class RecordingWriter(ClosesOnExit, ABC):
@@ -150,6 +160,7 @@ class RecordingWriter(ClosesOnExit, ABC):
             )
         if not kind:
             raise InvalidDataError(f"{self.path}: an event needs a kind")
+        _check_time_range(str(self.path), "events", int(t_ns), int(t_ns))
         self._last_event_ns = int(t_ns)
         self._write_event(int(t_ns), kind, text)
         self._after_write(int(t_ns))
@@ -204,6 +215,7 @@ class RecordingWriter(ClosesOnExit, ABC):
             return arr
         where = str(self.path)
         check_stream(where, stream, arr, strict)
+        _check_time_range(where, stream, int(arr["t_ns"][0]), int(arr["t_ns"][-1]))
         last = self._last[stream]
         if last is not None:
             for name in ("t_ns", "seq") if stream == "gauges" else ("t_ns",):

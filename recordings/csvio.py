@@ -22,7 +22,14 @@ from numpy.typing import NDArray
 from recordings.atomic import written_whole
 from recordings.base import EVENTS_DTYPE, register_format
 from recordings.csvtext import CsvOptions, CsvText, split_csv
-from recordings.errors import CorruptRecordingError, ImportMappingError, RecordingError, shown
+from recordings.errors import (
+    CorruptRecordingError,
+    ImportMappingError,
+    RecordingError,
+    listed,
+    one_line,
+    shown,
+)
 from recordings.foreign import FIELDS, ColumnMap, build_recording, resolve, to_unit
 from recordings.recording import Recording
 from recordings.schema import DRIVE_DTYPE, RecordingMetadata
@@ -91,8 +98,10 @@ def drive_array(polls: list[dict[str, Any]], where: str) -> NDArray[np.void]:
     try:
         for name in DRIVE_DTYPE.names or ():
             drive[name] = [p[name] for p in polls]
-    except (KeyError, TypeError, ValueError) as err:
-        raise CorruptRecordingError(f"{where}: unreadable drive polls: {err!r}") from None
+    except (KeyError, TypeError, ValueError, OverflowError) as err:  # Overflow: 2**70 ns
+        raise CorruptRecordingError(
+            f"{where}: unreadable drive polls: {one_line(repr(err))}"
+        ) from None
     return drive
 
 
@@ -122,7 +131,7 @@ def _stored(text: CsvText) -> _Stored:
                 other.append(line.strip())
         except RecordingError:  # the metadata's own complaint (newer schema, ...)
             raise
-        except (ValueError, KeyError, TypeError) as err:
+        except (ValueError, KeyError, TypeError, OverflowError) as err:  # 1e400 ns: Overflow
             raise ImportMappingError(f"{text.where}: unreadable labstand preamble: {err}") from None
     note = " / ".join(other)
     out.note = note if len(note) <= _NOTE_CHARS else note[: _NOTE_CHARS - 1] + "…"
@@ -161,7 +170,7 @@ def read_csv(
     found = resolve(columns, mapping or {}, where)
     if "time" not in found:
         raise ImportMappingError(
-            f"{where}: no time column (columns: {', '.join(columns)}); "
+            f"{where}: no time column (columns: {listed(list(columns))}); "
             "map it with --map time=COLUMN[s]"
         )
     values: dict[str, NDArray[np.float64]] = {}

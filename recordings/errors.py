@@ -15,6 +15,7 @@ __all__ = [
     "TruncatedRecordingError",
     "UnknownFormatError",
     "WriterClosedError",
+    "listed",
     "one_line",
     "shown",
     "size_text",
@@ -67,6 +68,13 @@ def shown(value: object, limit: int = 60) -> str:
         return f"an integer of {value.bit_length()} bits"
     text = repr(value)
     return text if len(text) <= limit else f"{text[: limit - 3]}..."
+
+
+def listed(names: list[str], limit: int = 12) -> str:
+    """Names for a one-line message: the first ``limit``, then how many in all."""
+    if len(names) <= limit:
+        return ", ".join(names)
+    return f"{', '.join(names[:limit])}, … ({len(names)} in all)"
 
 
 def size_text(n: int) -> str:

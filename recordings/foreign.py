@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from recordings.errors import ImportMappingError
+from recordings.errors import ImportMappingError, listed
 from recordings.recording import Recording
 from recordings.schema import COMMAND_DTYPE, GAUGES_DTYPE, Backend, make_metadata
 
@@ -116,7 +116,7 @@ def resolve(
                 found[field] = (bare["name"], entry.unit)
                 continue
             raise ImportMappingError(
-                f"{where}: no column {entry.name!r} for {field}; columns: {', '.join(columns)}"
+                f"{where}: no column {entry.name!r} for {field}; columns: {listed(list(columns))}"
             )
         for name in columns:
             base = _UNIT_IN_NAME.match(name)
@@ -127,7 +127,7 @@ def resolve(
     missing = [f for f in REQUIRED if f not in found]
     if missing:
         raise ImportMappingError(
-            f"{where}: no column for {', '.join(missing)} (columns: {', '.join(columns)}); "
+            f"{where}: no column for {', '.join(missing)} (columns: {listed(list(columns))}); "
             "map them with --map FIELD=COLUMN[UNIT]"
         )
     return found

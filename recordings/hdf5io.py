@@ -27,6 +27,9 @@ from __future__ import annotations
 
 import json
 import logging
+from collections.abc import Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -55,7 +58,7 @@ from recordings.schema import (
     concat_blocks,
 )
 
-__all__ = ["Hdf5RecordingWriter", "read_hdf5"]
+__all__ = ["CheckedHdf5", "Hdf5RecordingWriter", "checked_hdf5", "read_hdf5"]
 
 log = logging.getLogger(__name__)
 
@@ -233,10 +236,10 @@ def _open(path: Path, salvage: bool) -> tuple[h5py.File, list[str]]:
         ) from err
 
 
-def _read_stream(
-    h5: h5py.File, path: Path, name: str, dtype: np.dtype[Any], file_size: int, repairs: list[str]
-) -> NDArray[np.void]:
-    where = str(path)
+def _dataset(
+    h5: h5py.File, path: Path, name: str, dtype: np.dtype[Any], file_size: int
+) -> h5py.Dataset:
+    """A stream's dataset, checked (a hard link to a 1-D dataset of our fields and size)."""
     link = h5.get(name, getlink=True)
     if link is None:
         raise MissingChannelError(f"{path}: no dataset /{name}")
@@ -244,13 +247,17 @@ def _read_stream(
         raise CorruptRecordingError(f"{path}: /{name} is a {type(link).__name__}, not a dataset")
     ds = h5[name]
     if not isinstance(ds, h5py.Dataset):
-        raise MissingChannelError(f"{path}: no dataset /{name}")
-    check_dataset(ds, where, dtype, file_size)
+        raise CorruptRecordingError(f"{path}: /{name} is a {type(ds).__name__}, not a dataset")
+    check_dataset(ds, str(path), dtype, file_size)
+    return ds
+
+
+def _read_stream(ds: h5py.Dataset, path: Path, dtype: np.dtype[Any], repairs: list[str]) -> Any:
     try:
         return _read_rows(ds, dtype, repairs)
     except OSError as err:  # a chunk that fails its filter (gzip) or checksum
         raise CorruptRecordingError(
-            f"{path}: dataset /{name} cannot be read: {one_line(str(err))}"
+            f"{path}: dataset {ds.name} cannot be read: {one_line(str(err))}"
         ) from err
 
 
@@ -283,15 +290,37 @@ def _text(value: Any, row: int, where: str, repairs: list[str]) -> Any:
 #: What h5py raises for a damaged file: a failed checksum opening an object (KeyError),
 #: unreadable metadata or data (OSError, RuntimeError), a type it cannot convert.
 _H5_ERRORS = (KeyError, OSError, RuntimeError, TypeError, ValueError)
+STREAM_DTYPES = {
+    "gauges": GAUGES_DTYPE,
+    "command": COMMAND_DTYPE,
+    "drive": DRIVE_DTYPE,
+    "events": EVENTS_DTYPE,
+}
 
 
-def read_hdf5(path: Path, *, salvage: bool = False) -> Recording:
-    """Read an HDF5 recording (see ``open_recording``)."""
+@dataclass(frozen=True)
+class CheckedHdf5:
+    """An open HDF5 recording that passed every check, before any row is read."""
+
+    metadata: RecordingMetadata
+    datasets: dict[str, h5py.Dataset]
+    repairs: list[str]
+
+
+@contextmanager
+def checked_hdf5(path: Path, *, salvage: bool = False) -> Iterator[CheckedHdf5]:
+    """The one validation of an HDF5 recording, for every read path (whole or a window).
+
+    The global heaps (a hang in the library), the attributes' types, the metadata's
+    schema, each stream's link, shape, fields and size against the file's; what h5py
+    raises inside the block (a damaged chunk, a failed checksum) becomes
+    CorruptRecordingError.
+    """
     check_global_heaps(path)
     h5, repairs = _open(path, salvage)
     try:
         with h5:
-            return _read_open(h5, path, repairs)
+            yield CheckedHdf5(*_validate(h5, path), repairs)
     except RecordingError:
         raise
     except _H5_ERRORS as err:
@@ -299,7 +328,7 @@ def read_hdf5(path: Path, *, salvage: bool = False) -> Recording:
         raise CorruptRecordingError(f"{path}: damaged HDF5 file: {message}") from err
 
 
-def _read_open(h5: h5py.File, path: Path, repairs: list[str]) -> Recording:
+def _validate(h5: h5py.File, path: Path) -> tuple[RecordingMetadata, dict[str, h5py.Dataset]]:
     where = str(path)
     version = int_attr(h5.attrs, "schema_version", where)
     if version > SCHEMA_VERSION:
@@ -309,23 +338,25 @@ def _read_open(h5: h5py.File, path: Path, repairs: list[str]) -> Recording:
         )
     metadata = RecordingMetadata.from_json(text_attr(h5.attrs, "metadata_json", where), where)
     size = path.stat().st_size
-    streams = {
-        name: _read_stream(h5, path, name, dtype, size, repairs)
-        for name, dtype in (
-            ("gauges", GAUGES_DTYPE),
-            ("command", COMMAND_DTYPE),
-            ("drive", DRIVE_DTYPE),
-            ("events", EVENTS_DTYPE),
-        )
-    }
+    datasets = {name: _dataset(h5, path, name, dt, size) for name, dt in STREAM_DTYPES.items()}
+    return metadata, datasets
+
+
+def read_hdf5(path: Path, *, salvage: bool = False) -> Recording:
+    """Read an HDF5 recording (see ``open_recording``)."""
+    with checked_hdf5(path, salvage=salvage) as h5:
+        streams = {
+            name: _read_stream(ds, path, STREAM_DTYPES[name], h5.repairs)
+            for name, ds in h5.datasets.items()
+        }
     return Recording(
         path=path,
-        metadata=metadata,
+        metadata=h5.metadata,
         gauges=streams["gauges"],
         command=streams["command"],
         drive=streams["drive"],
         events_array=streams["events"],
-        repairs=repairs,
+        repairs=h5.repairs,
     )
 
 

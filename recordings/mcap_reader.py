@@ -35,25 +35,21 @@ from recordings.mcap_writer import (
     METADATA_NAME,
     TOPICS,
 )
+from recordings.mcapcheck import MAGIC, check_layout, chunk_limit
 from recordings.proto import DRIVE_STATE, EVENT, parse
 from recordings.recording import Recording
 from recordings.schema import DRIVE_DTYPE, RecordingMetadata
 
-__all__ = ["read_mcap"]
+__all__ = ["check_chunks", "read_mcap"]
 
 log = logging.getLogger(__name__)
 
-MAGIC = b"\x89MCAP0\r\n"
 _HEADER, _FOOTER, _SCHEMA, _CHANNEL, _MESSAGE, _CHUNK = 0x01, 0x02, 0x03, 0x04, 0x05, 0x06
 _MESSAGE_INDEX, _METADATA, _DATA_END = 0x07, 0x0C, 0x0F
 _RECORD = struct.Struct("<BQ")
 _MESSAGE_HEAD = struct.Struct("<HIQQ")
 _CHANNEL_ID = struct.Struct("<H")
 REQUIRED_TOPICS = ("/gauges", "/command", "/drive", "/events")
-#: A chunk may claim at most this much uncompressed data per compressed byte (zstd and lz4
-#: reach a few hundred on real data); a bit flip in the size field then cannot allocate GBs.
-MAX_CHUNK_RATIO = 1024
-MAX_CHUNK_BYTES = 2**30
 
 
 class _Walk:
@@ -125,7 +121,7 @@ class _Walk:
 
     def _decompress(self, chunk: Chunk) -> bytes:
         where = f"{self.where}: chunk {self.chunks + 1}"
-        limit = min(MAX_CHUNK_RATIO * len(chunk.data) + 2**16, MAX_CHUNK_BYTES)
+        limit = chunk_limit(len(chunk.data))
         if chunk.uncompressed_size > limit:
             raise CorruptRecordingError(
                 f"{where}: claims {chunk.uncompressed_size} bytes uncompressed from "
@@ -168,6 +164,12 @@ def _walk_file(path: Path, salvage: bool) -> _Walk:
     if data[:8] != MAGIC:
         raise CorruptRecordingError(f"{where}: not an MCAP file (no MCAP magic at the start)")
     walk = _Walk(where, salvage)
+    try:  # the layout check every read path runs; a salvage rebuilds the summary instead
+        check_layout(data, where)
+    except CorruptRecordingError as err:
+        if not salvage or "summary section is damaged" not in str(err):
+            raise
+        walk.repairs.append("the summary section was damaged: rebuilt from the data")
     view, pos, size = memoryview(data), len(MAGIC), len(data)
     ended = False
     while pos < size:
@@ -181,21 +183,7 @@ def _walk_file(path: Path, salvage: bool) -> _Walk:
             walk.chunks += 1  # e.g. the /gauges/plot chunks: not needed, not decompressed
             pos += _RECORD.size + length
             continue
-        try:
-            walk.record(opcode, body)
-        # OverflowError: a length field near 2**64 handed to BytesIO.read or a slice
-        except (struct.error, ValueError, UnicodeDecodeError, McapError, OverflowError) as err:
-            if isinstance(err, CorruptRecordingError):
-                raise
-            if isinstance(err, EndOfFile):
-                detail = "it ends before its fields do"
-            elif isinstance(err, OverflowError):
-                detail = "a length field in it is larger than any file"
-            else:
-                detail = one_line(str(err))
-            raise CorruptRecordingError(
-                f"{where}: record {opcode:#04x} at byte {pos} does not decode: {detail}"
-            ) from err
+        _decode(walk, opcode, body, pos)
         pos += _RECORD.size + length
         if opcode == _DATA_END:
             ended = True
@@ -204,6 +192,38 @@ def _walk_file(path: Path, salvage: bool) -> _Walk:
     if not intact:
         _truncated(walk, pos, size, ended)
     return walk
+
+
+def _decode(walk: _Walk, opcode: int, body: memoryview, pos: int) -> None:
+    """One top-level record into the walk; what does not decode, as CorruptRecordingError."""
+    try:
+        walk.record(opcode, body)
+    # OverflowError: a length field near 2**64 handed to BytesIO.read or a slice
+    except (struct.error, ValueError, UnicodeDecodeError, McapError, OverflowError) as err:
+        if isinstance(err, CorruptRecordingError):
+            raise
+        if isinstance(err, EndOfFile):
+            detail = "it ends before its fields do"
+        elif isinstance(err, OverflowError):
+            detail = "a length field in it is larger than any file"
+        else:
+            detail = one_line(str(err))
+        raise CorruptRecordingError(
+            f"{walk.where}: record {opcode:#04x} at byte {pos} does not decode: {detail}"
+        ) from err
+
+
+def check_chunks(chunks: list[tuple[int, bytes]], where: str) -> dict[int, Channel]:
+    """The whole read's checks of chunk records (offset in the file, the record's bytes).
+
+    Decompression, CRC and inner records, for the window reader, which hands those chunks
+    to the ``mcap`` package's reader (it checks less). Returns the channels the chunks
+    define, for the caller to hold against the summary's.
+    """
+    walk = _Walk(where, salvage=False)
+    for offset, record in chunks:
+        _decode(walk, _CHUNK, memoryview(record)[_RECORD.size :], offset)
+    return walk.channels
 
 
 def _only_skipped_channels(view: memoryview, pos: int, walk: _Walk) -> bool:

@@ -32,6 +32,7 @@ from mcap.writer import CompressionType, Writer
 from numpy.typing import NDArray
 
 from recordings.base import RecordingWriter, register_format
+from recordings.errors import InvalidDataError
 from recordings.proto import (
     DRIVE_STATE,
     EVENT,
@@ -44,6 +45,7 @@ from recordings.proto import (
 from recordings.schema import (
     COMMAND_DTYPE,
     GAUGES_DTYPE,
+    MAX_TIME_NS,
     SCHEMA_VERSION,
     UNITS,
     RecordingMetadata,
@@ -138,6 +140,11 @@ class McapRecordingWriter(RecordingWriter):
             (GAUGE_CODEC, COMMAND_CODEC) if time_s else _PLAIN_CODECS
         )
         self._start_ns = metadata.start_time_ns
+        if not 0 <= self._start_ns <= MAX_TIME_NS:  # MCAP log times: unsigned ns since 1970
+            raise InvalidDataError(
+                f"{path}: cannot write MCAP: start time {metadata.start_time_utc} is outside "
+                "1970 … 2255 (MCAP log times count nanoseconds from 1970)"
+            )
         self._file: BinaryIO = open(self.path, "wb")  # noqa: SIM115 (closed in _close)
         self._writer = Writer(self._file, chunk_size=8 * 2**20, compression=CompressionType.ZSTD)
         self._writer.start(profile="", library=f"labstand {software_version()}")

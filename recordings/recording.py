@@ -13,7 +13,14 @@ from numpy.typing import NDArray
 
 from recordings.base import EVENTS_DTYPE, check_stream, reader_for
 from recordings.errors import InvalidDataError
-from recordings.schema import COMMAND_DTYPE, DRIVE_DTYPE, GAUGES_DTYPE, RecordingMetadata
+from recordings.schema import (
+    COMMAND_DTYPE,
+    DRIVE_DTYPE,
+    GAUGES_DTYPE,
+    MAX_RUN_TIME_NS,
+    RecordingMetadata,
+)
+from sim.grid import MAX_GRID_FACTOR
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -74,6 +81,33 @@ class Recording:
         check_stream(where, "command", self.command)
         check_stream(where, "drive", self.drive, strict=False)
         check_stream(where, "events", self.events_array, strict=False)
+        self._check_times(where)
+
+    def _check_times(self, where: str) -> None:
+        """Times within ±MAX_RUN_TIME_NS, and a gauge clock whose grid is bounded.
+
+        Replay and compare put the gauges on a uniform grid at their median step; a time
+        that jumps far ahead (a damaged file) would size that grid in terabytes, so the
+        span is checked here, before anything is allocated from it.
+        """
+        for name in ("gauges", "command", "drive", "events_array"):
+            t = getattr(self, name)["t_ns"]  # increasing: checked above
+            if len(t) and not (int(t[0]) >= -MAX_RUN_TIME_NS and int(t[-1]) <= MAX_RUN_TIME_NS):
+                raise InvalidDataError(
+                    f"{where}: {name.removesuffix('_array')}.t_ns spans {int(t[0])} … "
+                    f"{int(t[-1])} ns, beyond ±{MAX_RUN_TIME_NS} ns (104 days) of the start"
+                )
+        t = self.gauges["t_ns"]
+        if len(t) < 2:
+            return
+        span_ns = int(t[-1]) - int(t[0])
+        step_ns = float(np.median(np.diff(t)))
+        if span_ns / step_ns + 1 > MAX_GRID_FACTOR * len(t):
+            raise InvalidDataError(
+                f"{where}: the gauges span {span_ns / 1e9:.6g} s with {len(t)} samples "
+                f"{step_ns / 1e9:.3g} s apart: more than {MAX_GRID_FACTOR - 1} of every "
+                f"{MAX_GRID_FACTOR} samples missing (a damaged time?)"
+            )
 
     @property
     def duration_s(self) -> float:

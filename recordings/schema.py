@@ -251,10 +251,16 @@ class RecordingMetadata:
                 f"({SCHEMA_VERSION}); update labstand"
             )
         rate = data.get("sample_rate_hz")
-        if isinstance(rate, bool) or not isinstance(rate, int | float) or not 0 < rate < 1e12:
+        if (
+            isinstance(rate, bool)
+            or not isinstance(rate, int | float)
+            or not 0 < rate <= MAX_SAMPLE_RATE_HZ
+        ):
             raise CorruptRecordingError(
-                f"{where}: metadata sample_rate_hz must be a number of Hz > 0, got {shown(rate)}"
+                f"{where}: metadata sample_rate_hz must be a number of Hz in "
+                f"(0, {MAX_SAMPLE_RATE_HZ:g}], got {shown(rate)}"
             )
+        _check_signal(data.get("signal"), where)
         try:
             effects = tuple(
                 Effect(str(e["name"]), {str(k): float(v) for k, v in e["params"].items()})
@@ -277,9 +283,14 @@ class RecordingMetadata:
                 run_id=str(data.get("run_id", "")),
                 tags=_tags(data.get("tags", []), where),
             )
-            _ = meta.start_time_ns
+            start_ns = meta.start_time_ns
         except (KeyError, TypeError, ValueError, AttributeError, OverflowError) as err:
             raise CorruptRecordingError(f"{where}: metadata is unusable: {err!r}") from err
+        if not 0 <= start_ns <= MAX_TIME_NS:
+            raise CorruptRecordingError(
+                f"{where}: metadata start_time_utc {shown(meta.start_time_utc)} is outside "
+                "1970 … 2255 (nanoseconds since 1970 must fit 63 bits with a run after it)"
+            )
         return meta
 
     @classmethod
@@ -305,6 +316,45 @@ def _tags(value: object, where: str) -> tuple[str, ...]:
             f"{where}: metadata tags must be a list of text, got {shown(value)}"
         )
     return tuple(value)
+
+
+#: The fastest nominal rate a recording may claim, Hz (the gauges stream at 2 kHz): a rate
+#: sizes the grids that replay and compare allocate.
+MAX_SAMPLE_RATE_HZ = 1e6
+#: Times of a run (``t_ns``) lie within ±2⁵³ ns (104 days): exact as float seconds, and a
+#: start time plus any of them still fits the 63 bits of an MCAP log time.
+MAX_RUN_TIME_NS = 2**53
+#: Start times (ns since 1970) up to this leave room for a run of MAX_RUN_TIME_NS.
+MAX_TIME_NS = 2**63 - 1 - MAX_RUN_TIME_NS
+_SIGNAL_NUMBERS = ("amplitude_mm", "frequency_hz")
+
+
+def _check_signal(signal: Any, where: str) -> None:
+    """The metadata's drive signal: None, or an object with a shape and its numbers."""
+    if signal is None:
+        return
+    if not isinstance(signal, dict):
+        raise CorruptRecordingError(
+            f"{where}: metadata signal must be an object, got {shown(signal)}"
+        )
+    missing = [k for k in ("shape", *_SIGNAL_NUMBERS, "cycles") if k not in signal]
+    if missing:
+        raise CorruptRecordingError(f"{where}: metadata signal lacks {', '.join(missing)}")
+    if not isinstance(signal["shape"], str):
+        raise CorruptRecordingError(
+            f"{where}: metadata signal shape must be text, got {shown(signal['shape'])}"
+        )
+    for key in _SIGNAL_NUMBERS:
+        value = signal[key]
+        if isinstance(value, bool) or not isinstance(value, int | float) or abs(value) > 1e300:
+            raise CorruptRecordingError(
+                f"{where}: metadata signal {key} must be a number, got {shown(value)}"
+            )
+    cycles = signal["cycles"]
+    if isinstance(cycles, bool) or not isinstance(cycles, int) or abs(cycles) > 2**53:
+        raise CorruptRecordingError(
+            f"{where}: metadata signal cycles must be a whole number, got {shown(cycles)}"
+        )
 
 
 def software_version() -> str:

@@ -36,7 +36,7 @@ from numpy.typing import NDArray
 
 from recordings.base import EVENTS_DTYPE, TABLE_SUFFIXES, register_format
 from recordings.csvio import DRIVE_TAG, EVENT_TAG, METADATA_TAG, drive_array
-from recordings.errors import CorruptRecordingError, MissingChannelError
+from recordings.errors import CorruptRecordingError, MissingChannelError, one_line
 from recordings.recording import Recording
 from recordings.schema import COMMAND_DTYPE, DRIVE_DTYPE, GAUGES_DTYPE, RecordingMetadata
 
@@ -134,7 +134,9 @@ def read_parquet(path: Path, *, salvage: bool = False) -> Recording:
     except (pa.ArrowException, OSError) as err:
         if isinstance(err, FileNotFoundError):
             raise
-        raise CorruptRecordingError(f"{where}: not a readable Parquet file: {err}") from None
+        raise CorruptRecordingError(
+            f"{where}: not a readable Parquet file: {one_line(str(err))}"
+        ) from None
     extra = {k.decode(): v.decode() for k, v in (table.schema.metadata or {}).items()}
     if "labstand.metadata" not in extra:
         raise MissingChannelError(f"{where}: no labstand.metadata (not a labstand export)")
@@ -145,30 +147,19 @@ def read_parquet(path: Path, *, salvage: bool = False) -> Recording:
     if missing:
         raise MissingChannelError(f"{where}: no column(s) {', '.join(missing)}")
 
-    def column(name: str) -> NDArray[Any]:
-        return np.asarray(table.column(name).to_numpy(zero_copy_only=False))
-
-    gauges = np.empty(table.num_rows, dtype=GAUGES_DTYPE)
-    gauges["t_ns"], gauges["seq"], gauges["flags"] = column("t_ns"), column("seq"), column("flags")
-    gauges["x_mm"], gauges["u_mm"], gauges["force_n"] = (
-        column("x_mm"),
-        column("u_mm"),
-        column("F_N"),
-    )
-    command = np.empty(0, dtype=COMMAND_DTYPE)
-    if "x_cmd_mm" in table.column_names:
-        x_cmd = table.column("x_cmd_mm").to_numpy(zero_copy_only=False).astype(np.float64)
-        present = np.isfinite(x_cmd)
-        command = np.empty(int(present.sum()), dtype=COMMAND_DTYPE)
-        command["t_ns"], command["x_cmd_mm"] = gauges["t_ns"][present], x_cmd[present]
+    gauges, command = _parquet_streams(table, where)
     try:
         events = [
             (int(e["t_ns"]), str(e["kind"]), str(e["text"]))
             for e in json.loads(extra.get("labstand.events", "[]"))
         ]
         polls = json.loads(extra.get("labstand.drive", "[]"))
-    except (ValueError, KeyError, TypeError) as err:
-        raise CorruptRecordingError(f"{where}: unreadable labstand metadata: {err!r}") from None
+        if not isinstance(polls, list):
+            raise TypeError(f"labstand.drive is {type(polls).__name__}, not a list")
+    # RecursionError: JSON nested thousands deep; OverflowError: a time of 1e400
+    except (ValueError, KeyError, TypeError, OverflowError, RecursionError) as err:
+        message = one_line(repr(err))
+        raise CorruptRecordingError(f"{where}: unreadable labstand metadata: {message}") from None
     return Recording(
         path=path,
         metadata=meta,
@@ -177,6 +168,41 @@ def read_parquet(path: Path, *, salvage: bool = False) -> Recording:
         drive=drive_array(polls, where),
         events_array=np.array(events, dtype=EVENTS_DTYPE).reshape(len(events)),
     )
+
+
+_PARQUET_KINDS = {"t_ns": "iu", "seq": "iu", "flags": "iub", "x_mm": "iuf", "u_mm": "iuf"}
+_PARQUET_KINDS |= {"F_N": "iuf", "x_cmd_mm": "iuf"}
+
+
+def _parquet_streams(table: Any, where: str) -> tuple[NDArray[np.void], NDArray[np.void]]:
+    """The gauges and command of a labstand table; every column of the type it must be."""
+
+    def column(name: str) -> NDArray[Any]:
+        values = np.asarray(table.column(name).to_numpy(zero_copy_only=False))
+        if values.dtype.kind not in _PARQUET_KINDS[name] or values.ndim != 1:
+            raise CorruptRecordingError(
+                f"{where}: column {name} holds {values.dtype} values, not numbers"
+            )
+        return values
+
+    gauges = np.empty(table.num_rows, dtype=GAUGES_DTYPE)
+    with np.errstate(invalid="raise"):  # NaN into an integer field: refused, not warned
+        try:
+            gauges["t_ns"], gauges["seq"] = column("t_ns"), column("seq")
+            gauges["flags"] = column("flags")
+            gauges["x_mm"], gauges["u_mm"] = column("x_mm"), column("u_mm")
+            gauges["force_n"] = column("F_N")
+        except (FloatingPointError, OverflowError, ValueError, TypeError) as err:
+            if isinstance(err, CorruptRecordingError):
+                raise
+            raise CorruptRecordingError(f"{where}: unusable column: {one_line(str(err))}") from None
+    command = np.empty(0, dtype=COMMAND_DTYPE)
+    if "x_cmd_mm" in table.column_names:
+        x_cmd = column("x_cmd_mm").astype(np.float64)
+        present = np.isfinite(x_cmd)
+        command = np.empty(int(present.sum()), dtype=COMMAND_DTYPE)
+        command["t_ns"], command["x_cmd_mm"] = gauges["t_ns"][present], x_cmd[present]
+    return gauges, command
 
 
 register_format("Parquet", (".parquet",), reader=read_parquet)

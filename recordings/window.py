@@ -17,15 +17,19 @@ from __future__ import annotations
 
 import bisect
 import logging
+import mmap
+import os
+import struct
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, BinaryIO
 
 import numpy as np
 from numpy.typing import NDArray
 
-from recordings.base import EVENTS_DTYPE
-from recordings.errors import RecordingError
+from recordings.base import EVENTS_DTYPE, check_stream
+from recordings.errors import CorruptRecordingError, RecordingError
+from recordings.mcapcheck import McapLayout
 from recordings.recording import Recording, open_recording
 from recordings.schema import COMMAND_DTYPE, DRIVE_DTYPE, GAUGES_DTYPE, RecordingMetadata
 
@@ -150,15 +154,17 @@ def _finish(
 
 def _mcap_window(path: Path, start_s: float | None, end_s: float | None) -> Window:
     from mcap.exceptions import McapError
-    from mcap.reader import make_reader
+    from mcap.reader import SeekingReader
 
     from recordings.mcap_writer import COMMAND_CODEC, DRIVE_CODEC, GAUGE_CODEC, METADATA_NAME
+    from recordings.mcapcheck import MAX_CHUNK_BYTES
     from recordings.proto import EVENT, parse
 
     where = str(path)
     try:
         with path.open("rb") as f:
-            reader = make_reader(f)
+            layout = _check_mcap_layout(f, where)
+            reader = SeekingReader(f, validate_crcs=True, record_size_limit=MAX_CHUNK_BYTES)
             if reader.get_summary() is None:
                 raise _FallbackError("no summary section")
             meta_json = next(
@@ -184,6 +190,8 @@ def _mcap_window(path: Path, start_s: float | None, end_s: float | None) -> Wind
             span = (int(head["t_ns"][0]), int(tail["t_ns"][-1]))
             _check(where, start_s, end_s, span)
             lo, hi = _bounds(start_s, end_s, span)
+            channels = _check_window_chunks(f, layout, t0 + lo, t0 + hi, where)
+            _same_channels(channels, reader.get_summary(), where)
             streams: dict[str, Any] = {}
             for name, topic, codec in (
                 ("gauges", "/gauges", GAUGE_CODEC),
@@ -194,22 +202,74 @@ def _mcap_window(path: Path, start_s: float | None, end_s: float | None) -> Wind
                     reader.iter_messages(topics=[topic], ending_before=t0 + lo, reverse=True), None
                 )
                 data = ([before[2].data] if before else []) + batches(topic, lo, hi)
-                streams[name] = _slice(codec.decode_many(data, where), lo, hi)
+                decoded = codec.decode_many(data, where)
+                check_stream(where, name, decoded)  # all it read, not only the window's part
+                streams[name] = _slice(decoded, lo, hi)
             drive = DRIVE_CODEC.decode_fast(batches("/drive", lo, hi))
             if drive is None:
                 raise _FallbackError("drive polls not in the fixed layout")
-            streams["drive"] = _slice(_as(drive, DRIVE_DTYPE), lo, hi)
+            drive_rows = _as(drive, DRIVE_DTYPE)
+            check_stream(where, "drive", drive_rows, strict=False)
+            streams["drive"] = _slice(drive_rows, lo, hi)
             e_lo, e_hi = _event_bounds(start_s, end_s, lo, hi)
             e_lo, e_hi = max(e_lo, -t0), min(e_hi, 2**63 - 1 - t0)
             events = [parse(EVENT, d, where) for d in batches("/events", e_lo, e_hi)]
             streams["events"] = np.array(
                 [(e.t_ns, e.kind, e.text) for e in events], dtype=EVENTS_DTYPE
             ).reshape(len(events))
-    except WindowError:
+    except RecordingError:
         raise
-    except (McapError, EOFError, ValueError, KeyError) as err:
+    # what the seeking reader may still raise inside a chunk: the walk says what is wrong
+    except (McapError, EOFError, ValueError, KeyError, struct.error, OverflowError) as err:
         raise _FallbackError(f"{type(err).__name__}: {err}") from err
     return _finish(path, meta, streams, (lo, hi), span)
+
+
+def _check_mcap_layout(f: BinaryIO, where: str) -> McapLayout:
+    """The MCAP layout check of every read path; a file it finds cut goes to the walk."""
+    from recordings.mcapcheck import check_layout
+
+    if os.fstat(f.fileno()).st_size < 16:
+        raise _FallbackError("shorter than an MCAP header")
+    with mmap.mmap(f.fileno(), 0, access=mmap.ACCESS_READ) as data:
+        layout = check_layout(data, where)  # type: ignore[arg-type]  # mmap reads as bytes
+        if not layout.intact:
+            raise _FallbackError(layout.problem)
+    return layout
+
+
+def _same_channels(data: dict[int, Any], summary: Any, where: str) -> None:
+    """The channels the data defines must be the summary's (the seeking reader's)."""
+    for cid, channel in data.items():
+        known = summary.channels.get(cid) if summary is not None else None
+        mine = (channel.topic, channel.schema_id, channel.message_encoding)
+        if known is None or (known.topic, known.schema_id, known.message_encoding) != mine:
+            raise CorruptRecordingError(
+                f"{where}: channel {cid} ({channel.topic!r}) differs between the data and "
+                f"the summary; `labstand recover {where} -o FIXED.mcap` rebuilds the summary"
+            )
+
+
+def _check_window_chunks(
+    f: BinaryIO, layout: McapLayout, lo: int, hi: int, where: str
+) -> dict[int, Any]:
+    """The whole read's chunk checks on the chunks the window reads (and the edges').
+
+    Those overlapping ``lo … hi`` (log times), the one before them (its batch starts
+    before the window), and the first and last (the span's edges).
+    """
+    from recordings.mcap_reader import check_chunks
+
+    chunks = layout.chunks
+    if not chunks:
+        return {}
+    hit = [i for i, c in enumerate(chunks) if c.end_ns >= lo and c.start_ns <= hi]
+    picked = set(hit) | {0, len(chunks) - 1} | ({hit[0] - 1} if hit and hit[0] else set())
+    wanted = []
+    for i in sorted(picked):
+        f.seek(chunks[i].offset)  # inside the file: the layout check saw the whole record
+        wanted.append((chunks[i].offset, f.read(chunks[i].length)))
+    return check_chunks(wanted, where)
 
 
 def _as(fields: Any, dtype: np.dtype[Any]) -> NDArray[np.void]:
@@ -221,42 +281,36 @@ def _as(fields: Any, dtype: np.dtype[Any]) -> NDArray[np.void]:
 
 
 def _hdf5_window(path: Path, start_s: float | None, end_s: float | None) -> Window:
-    import h5py
+    from recordings.hdf5io import checked_hdf5
 
     where = str(path)
-    try:
-        with h5py.File(path, "r") as h5:
-            meta = RecordingMetadata.from_json(h5.attrs["metadata_json"], where)
-            g = h5["gauges"]
-            if len(g) == 0:
-                raise _FallbackError("no gauge samples")
-            span = (int(g[0]["t_ns"]), int(g[-1]["t_ns"]))
-            _check(where, start_s, end_s, span)
-            lo, hi = _bounds(start_s, end_s, span)
-            streams: dict[str, Any] = {}
-            for name, dtype in (
-                ("gauges", GAUGES_DTYPE),
-                ("command", COMMAND_DTYPE),
-                ("drive", DRIVE_DTYPE),
-            ):
-                ds = h5[name]
-                rows = range(len(ds))
+    with checked_hdf5(path) as h5:  # the same checks as a whole read: links, shapes, sizes
+        ds = h5.datasets
+        g = ds["gauges"]
+        if len(g) == 0:
+            raise _FallbackError("no gauge samples")
+        span = (int(g[0]["t_ns"]), int(g[-1]["t_ns"]))
+        _check(where, start_s, end_s, span)
+        lo, hi = _bounds(start_s, end_s, span)
+        streams: dict[str, Any] = {}
+        for name, dtype in (
+            ("gauges", GAUGES_DTYPE),
+            ("command", COMMAND_DTYPE),
+            ("drive", DRIVE_DTYPE),
+        ):
+            rows = range(len(ds[name]))
 
-                def t_at(i: int, ds: Any = ds) -> int:
-                    return int(ds[i]["t_ns"])
+            def t_at(i: int, d: Any = ds[name]) -> int:
+                return int(d[i]["t_ns"])
 
-                a = bisect.bisect_left(rows, lo, key=t_at)
-                b = bisect.bisect_right(rows, hi, key=t_at)
-                part = np.asarray(ds[a:b]) if b > a else np.empty(0, ds.dtype)
-                streams[name] = _as(part, dtype)
-            e = h5["events"][...]
-            events = np.empty(len(e), dtype=EVENTS_DTYPE)
-            events["t_ns"] = e["t_ns"]
-            for key in ("kind", "text"):
-                events[key] = [v.decode() if isinstance(v, bytes) else str(v) for v in e[key]]
-            streams["events"] = _slice(events, *_event_bounds(start_s, end_s, lo, hi))
-    except WindowError:
-        raise
-    except (OSError, KeyError, ValueError, TypeError) as err:
-        raise _FallbackError(f"{type(err).__name__}: {err}") from err
-    return _finish(path, meta, streams, (lo, hi), span)
+            a = bisect.bisect_left(rows, lo, key=t_at)
+            b = bisect.bisect_right(rows, hi, key=t_at)
+            part = np.asarray(ds[name][a:b]) if b > a else np.empty(0, ds[name].dtype)
+            streams[name] = _as(part, dtype)
+        e = ds["events"][...]
+        events = np.empty(len(e), dtype=EVENTS_DTYPE)
+        events["t_ns"] = e["t_ns"]
+        for key in ("kind", "text"):
+            events[key] = [v.decode() if isinstance(v, bytes) else str(v) for v in e[key]]
+        streams["events"] = _slice(events, *_event_bounds(start_s, end_s, lo, hi))
+    return _finish(path, h5.metadata, streams, (lo, hi), span)

@@ -38,6 +38,12 @@ DEFAULT_SOURCE = "<default stand>"
 #: Arrays, inline tables and dotted keys nested deeper than this are refused before parsing
 #: (tomllib recurses once per level; the stand file's deepest key is 3 levels down).
 MAX_NESTING = 16
+#: A stand file is a few kB; one larger than this is refused before it is read (tomllib
+#: holds the whole text and its tables in memory).
+MAX_STAND_FILE_BYTES = 2**20
+#: The fastest acquisition rate a stand file may ask for, Hz: the gauges stream at 2 kHz,
+#: and the rate sizes every simulated and recorded array (1e12 asked for 29 TiB).
+MAX_SAMPLE_RATE_HZ = 1e5
 
 
 class ConfigError(ValueError):
@@ -162,7 +168,7 @@ _FIXED_TABLES: dict[str, dict[str, Check]] = {
         "speed_max_m_s": POSITIVE,
         "accel_max_m_s2": POSITIVE,
     },
-    "acquisition": {"sample_rate_hz": POSITIVE},
+    "acquisition": {"sample_rate_hz": _number(0.0, MAX_SAMPLE_RATE_HZ)},
     "gauges": {
         "force_n_per_count": POSITIVE,
         "force_offset_n": ANY_NUMBER,
@@ -359,6 +365,10 @@ def load_config(path: str | Path | None) -> StandConfig:
         return default_config()
     p = Path(path)
     try:
+        if (size := p.stat().st_size) > MAX_STAND_FILE_BYTES:
+            raise ConfigError(
+                f"{p}: {size} bytes, larger than a stand file can be ({MAX_STAND_FILE_BYTES} bytes)"
+            )
         text = p.read_text(encoding="utf-8")
     except FileNotFoundError:
         raise ConfigError(f"{p}: no such stand file") from None
@@ -375,20 +385,29 @@ def load_config(path: str | Path | None) -> StandConfig:
     return config_from_dict(data, str(p))
 
 
-_TOKENS = re.compile(r"[\[\]{}\"'#\n]")
+_TOKENS = re.compile(r"[\[\]{}\"'#\n=]|(?<![0-9])\.|\.(?![0-9])")
 
 
 def _too_deep_text(text: str) -> str | None:
     """``line N`` where brackets outside strings and comments nest too deeply, or None.
 
     tomllib recurses once per nested array or inline table, so a file of thousands of
-    ``[`` would end in a RecursionError; this scan is iterative.
+    ``[`` would end in a RecursionError, and it builds a table per part of a dotted key
+    (50 000 parts took 14 GB): this scan is iterative and counts both, a dot that is
+    not between two digits (a number's) as one level of the line's key.
     """
-    depth, line, pos = 0, 1, 0
+    depth, dots, line, pos = 0, 0, 1, 0
     while (m := _TOKENS.search(text, pos)) is not None:
         c, pos = m.group(), m.end()
         if c == "\n":
             line += 1
+            dots = 0
+        elif c == ".":
+            dots += 1
+            if depth + dots > MAX_NESTING:
+                return f"line {line}"
+        elif c == "=":
+            dots = 0  # a value follows; an inline table's keys count anew
         elif c == "#":
             end = text.find("\n", pos)
             pos = len(text) if end < 0 else end

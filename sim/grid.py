@@ -16,10 +16,14 @@ from numpy.typing import NDArray
 FloatArray = NDArray[np.float64]
 BoolArray = NDArray[np.bool_]
 
-__all__ = ["REST_TOLERANCE_M", "AlignedRun", "GridError", "align_arrays"]
+__all__ = ["MAX_GRID_FACTOR", "REST_TOLERANCE_M", "AlignedRun", "GridError", "align_arrays"]
 
 #: The drive counts as at rest while within this distance of its first position, m.
 REST_TOLERANCE_M = 0.05e-3
+#: A grid may have at most this many points per sample (15 of 16 lost): the bound that
+#: keeps a damaged time (a jump to 2⁶³ ns) from sizing arrays of terabytes. Readers
+#: refuse such a recording first (``recordings.Recording.check``).
+MAX_GRID_FACTOR = 16
 
 
 class GridError(ValueError):
@@ -69,6 +73,11 @@ def align_arrays(
     if np.any(np.diff(slot) <= 0):
         raise GridError("samples do not fall on a uniform grid at the recording's rate")
     n = int(slot[-1]) + 1
+    if n > MAX_GRID_FACTOR * t.size:
+        raise GridError(
+            f"the samples span {n} grid points at {rate:g} Hz for {t.size} samples: "
+            f"more than {MAX_GRID_FACTOR - 1} of {MAX_GRID_FACTOR} missing"
+        )
     grid_t = t[0] + np.arange(n) / rate
     present = np.zeros(n, dtype=bool)
     present[slot] = True

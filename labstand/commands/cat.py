@@ -9,6 +9,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from labstand.errors import CommandError, ExitCode
+from labstand.terminal import printable
 
 if TYPE_CHECKING:
     import numpy as np
@@ -80,8 +81,8 @@ def run(args: argparse.Namespace) -> int:
     rec = window.recording
     if args.events:
         for t_ns, kind, text in rec.events_array.tolist():
-            flat = " ".join(str(text).split())
-            sys.stdout.write(f"{t_ns / 1e9:.6f}\t{kind}\t{flat}\n")
+            flat = printable(" ".join(str(text).split()))  # no terminal escapes from a file
+            sys.stdout.write(f"{t_ns / 1e9:.6f}\t{printable(str(kind))}\t{flat}\n")
         return 0
     columns = columns_for(args.channels, len(rec.command) > 0)
     if "x_cmd_mm" in columns and not len(rec.command):

@@ -29,12 +29,14 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Compare and report."""
+    from recordings import open_recording
+
+    a, b = open_recording(args.a), open_recording(args.b)  # refused before numba loads
+
     from labstand.commands.replay import print_metrics
     from labstand.plots import plot_replay
-    from recordings import open_recording
     from recordings.replay import compare_runs
 
-    a, b = open_recording(args.a), open_recording(args.b)
     result = compare_runs(a.frame(), b.frame())
     warnings = differences(a.metadata, b.metadata)
     out = {"a": str(args.a), "b": str(args.b), **result.to_dict(), "warnings": warnings}

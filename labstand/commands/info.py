@@ -7,6 +7,8 @@ import json
 from pathlib import Path
 from typing import Any
 
+from labstand.terminal import printable
+
 
 def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Add ``labstand info``."""
@@ -37,18 +39,23 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
+def _say(line: str) -> None:
+    """One line of the text output; the file's own text escaped (labstand.terminal)."""
+    print(printable(line))
+
+
 def _print(info: dict[str, Any]) -> None:
     meta = info["metadata"]
-    print(f"{info['path']}: schema {meta['schema_version']}, backend {meta['backend']}")
-    print(
+    _say(f"{info['path']}: schema {meta['schema_version']}, backend {meta['backend']}")
+    _say(
         f"  {info['duration_s']:.3f} s from {info['start_time_utc']}, {info['samples']} samples, "
         f"{info['lost_samples']} lost in {info['gaps']} gap(s)"
     )
-    print(f"  written by labstand {meta['software_version']} on {meta['host'] or '?'}")
+    _say(f"  written by labstand {meta['software_version']} on {meta['host'] or '?'}")
     if meta["signal"]:
         sig = meta["signal"]
         situation = f"situation {sig['situation']}: " if sig.get("situation") else ""
-        print(
+        _say(
             f"  signal {situation}{sig['shape']}, A = {sig['amplitude_mm']:g} mm, "
             f"f = {sig['frequency_hz']:g} Hz, {sig['cycles']} cycle(s)"
         )
@@ -65,13 +72,13 @@ def _print(info: dict[str, Any]) -> None:
     if meta.get("run_id"):
         print(f"  run {meta['run_id']}")
     if meta["operator_note"]:
-        print(f"  note: {meta['operator_note']}")
-    print("  channels:")
+        _say(f"  note: {meta['operator_note']}")
+    _say("  channels:")
     for name, ch in info["channels"].items():
         rate = f"{ch['rate_hz']:g} Hz" if ch["rate_hz"] else "irregular"
-        print(f"    {name:<22} {ch['unit'] or '-':<5} {rate:>10} {ch['samples']:>9} samples")
+        _say(f"    {name:<22} {ch['unit'] or '-':<5} {rate:>10} {ch['samples']:>9} samples")
     for line in info["repairs"]:
-        print(f"  repaired: {line}")
+        _say(f"  repaired: {line}")
     _print_events(info["event_list"])
 
 
@@ -83,14 +90,14 @@ ENDINGS = ("stop", "estop", "fault")
 
 def _print_events(events: list[dict[str, Any]]) -> None:
     if not events:
-        print("  events: none")
+        _say("  events: none")
         return
-    print(f"  events ({len(events)}):")
+    _say(f"  events ({len(events)}):")
     shown = events if len(events) <= SHOWN_EVENTS else events[: SHOWN_EVENTS - 1]
     for e in shown:
-        print(f"    {e['t_s']:12.6f} s  {e['kind']:<7} {' '.join(e['text'].split())}")
+        _say(f"    {e['t_s']:12.6f} s  {e['kind']:<7} {' '.join(e['text'].split())}")
     if len(shown) < len(events):
-        print(f"    … {len(events) - len(shown)} more (labstand cat REC --events)")
+        _say(f"    … {len(events) - len(shown)} more (labstand cat REC --events)")
     ending = next((e for e in reversed(events) if e["kind"] in ENDINGS), None)
     if ending is not None:
-        print(f"  ended: {ending['kind']} at {ending['t_s']:.6f} s: {ending['text']}")
+        _say(f"  ended: {ending['kind']} at {ending['t_s']:.6f} s: {ending['text']}")

@@ -14,8 +14,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    import threading
-
+    from labstand.interrupts import Interrupt
     from labstand.live.address import ViewerAddress
     from recordings import Recording
     from sim.params import StandParams
@@ -90,7 +89,7 @@ def _serve(
     recording: Recording,
     params: StandParams,
     name: str,
-    interrupted: threading.Event,
+    interrupted: Interrupt,
 ) -> int:
     """Play once (or loop) to the clients of a server at ``address``."""
     import time
@@ -121,7 +120,7 @@ def _serve(
             end_ns = start_ns + player.span_ns
             stats = player.play(stop=interrupted.is_set)
             if interrupted.is_set():
-                raise KeyboardInterrupt
+                interrupted.raise_it()
             passes += 1
             print(
                 f"  pass {passes}: {stats.samples} samples, {stats.drive} drive polls, "

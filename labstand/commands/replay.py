@@ -77,11 +77,13 @@ class ReplayJob:
 
 def replay_one(job: ReplayJob) -> dict[str, Any]:
     """The job: a recording's replay as JSON, its plot written (runs on a worker for many)."""
-    from labstand.recording_stand import mass_source, params_for
     from recordings import open_recording
+
+    recording = open_recording(job.recording)  # refused before the model loads (numba: s)
+
+    from labstand.recording_stand import mass_source, params_for
     from recordings.replay import replay
 
-    recording = open_recording(job.recording)
     params, name = params_for(recording, job.stand, job.params, job.mass_kg)
     result = replay(recording.frame(), params)
     out = {

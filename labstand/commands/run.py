@@ -199,8 +199,10 @@ def _check(args: argparse.Namespace) -> _Plan:
 
 def run(args: argparse.Namespace) -> int:
     """Check, confirm, run, report."""
-    if not args.verbose:  # its time-outs are reported by the drive driver, once
-        logging.getLogger("pymodbus").setLevel(logging.CRITICAL)
+    if not args.verbose:  # the device layer's retries and warnings: the log (-v), not the
+        # terminal, where the run's end is one line that says what failed
+        for name in ("pymodbus", "drivers", "sim.hardware"):
+            logging.getLogger(name).setLevel(logging.CRITICAL)
     plan = _check(args)
     with contextlib.ExitStack() as stack:
         live = None
@@ -275,7 +277,7 @@ def _session(
             session.prepare(pre, stop)
         except EStopError as err:
             session.shutdown()
-            code = ExitCode.INTERRUPTED if stop.presses else ExitCode.ESTOP
+            code = _stop_code(stop.by) if stop.presses else ExitCode.ESTOP
             drive = "drive disabled" if session.drive_disabled else "the drive did not answer"
             raise CommandError(f"{err}; {drive}; nothing recorded", code) from err
         metadata = make_metadata(
@@ -357,9 +359,9 @@ def _stop_signals(stop: StopRequest) -> Iterator[None]:
         return
 
     def handler(signum: int, frame: FrameType | None) -> None:
-        stop.press()
+        stop.press("SIGTERM" if signum == signal.SIGTERM else "Ctrl-C")
         text = (
-            "\nlabstand: stopping in order (Ctrl-C again: disable the drive at once)\n"
+            f"\nlabstand: {stop.by}: stopping in order (again: disable the drive at once)\n"
             if stop.presses == 1
             else "\nlabstand: disabling the drive at once\n"
         )
@@ -393,5 +395,11 @@ def _report(result: RunResult, output: Path, sim: dict[str, Any]) -> int:
     if result.outcome is Outcome.DONE:
         _say(f"Done: {drive}; {where}")
         return ExitCode.OK
-    code = ExitCode.INTERRUPTED if result.outcome is Outcome.STOPPED else ExitCode.ESTOP
+    by = result.reason.split(" ", 1)[0]  # "SIGTERM at 1.20 s: controlled stop"
+    code = _stop_code(by) if result.outcome is Outcome.STOPPED else ExitCode.ESTOP
     raise CommandError(f"{result.reason}; {drive}; {where}", code)
+
+
+def _stop_code(by: str) -> ExitCode:
+    """130 for Ctrl-C, 143 for SIGTERM: the signal named as it came."""
+    return ExitCode.TERMINATED if by == "SIGTERM" else ExitCode.INTERRUPTED

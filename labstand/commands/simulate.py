@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import time
 from dataclasses import replace
 from pathlib import Path
@@ -78,6 +79,8 @@ def signal_from_args(args: argparse.Namespace, config: StandConfig) -> tuple[Sig
         mass = config.default_mass_kg
     if args.mass_kg is not None:
         mass = args.mass_kg
+    if not (math.isfinite(mass) and mass > 0):  # before any stand starts
+        raise CommandError(f"--mass-kg: mass must be > 0 kg, got {mass:g}", ExitCode.USAGE)
     return spec, mass
 
 

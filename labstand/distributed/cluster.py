@@ -146,14 +146,14 @@ def open_client(
         Client(cluster) as client,
     ):
         if interrupted.is_set():  # Ctrl-C while the workers started
-            raise KeyboardInterrupt
+            interrupted.raise_it()
         say(
             f"local cluster: {n} worker process(es) × 1 thread, numba {threads} thread(s) "
             f"each; {_dashboard(client)}"
         )
         yield client, threads
         if interrupted.is_set():  # a Ctrl-C that Dask's waiting swallowed
-            raise KeyboardInterrupt
+            interrupted.raise_it()
 
 
 def _dashboard(client: Client) -> str:

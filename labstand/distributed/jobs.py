@@ -14,7 +14,6 @@ Faults, and what each costs:
 from __future__ import annotations
 
 import sys
-import threading
 import time
 import uuid
 from collections.abc import Callable, Sequence
@@ -23,7 +22,7 @@ from typing import TYPE_CHECKING, Any, Generic, TypeVar
 
 from labstand.distributed.progress import Progress
 from labstand.errors import ExitCode, describe_os_error
-from labstand.interrupts import remembered_interrupt
+from labstand.interrupts import Interrupt, remembered_interrupt
 
 if TYPE_CHECKING:  # dask is imported where it runs: a command's --help stays quick
     from distributed import Client
@@ -120,6 +119,7 @@ def run_jobs(
         ]
     with remembered_interrupt() as interrupted:
         if submitting.is_set():
+            interrupted.terminated = submitting.terminated
             interrupted.set()
         return _gather(client, futures, keys, progress, tell, interrupted)
 
@@ -130,7 +130,7 @@ def _gather(
     keys: Sequence[str],
     progress: Progress,
     tell: Callable[[JobResult[R]], str],
-    interrupted: threading.Event,
+    interrupted: Interrupt,
 ) -> list[JobResult[R]]:
     """The jobs' results as they finish, in the items' order; Ctrl-C cancels the rest."""
     from distributed import as_completed
@@ -139,10 +139,10 @@ def _gather(
     results: dict[int, JobResult[R]] = {}
     try:
         if interrupted.is_set():  # during the submission
-            raise KeyboardInterrupt
+            interrupted.raise_it()
         for future in as_completed(futures):
             if interrupted.is_set():
-                raise KeyboardInterrupt
+                interrupted.raise_it()
             i = index[future.key]
             try:
                 out: tuple[Any, str | None, str | None, float, str, bool] = future.result()
@@ -152,7 +152,7 @@ def _gather(
                                        type(err).__name__, 0.0, "")  # fmt: skip
             progress.advance(tell(results[i]))
         if interrupted.is_set():
-            raise KeyboardInterrupt
+            interrupted.raise_it()
     finally:
         client.cancel([f for f in futures if not f.done()])
         progress.close()

@@ -5,6 +5,11 @@ takes every queued gauge block (stamped by the ``RunClock``, handed to the
 ``RecordingPipe``, checked by the ``SafetyMonitor``), checks the gauge stream's
 silence, polls the drive when a poll is due (each poll toggles the drive's watchdog)
 and refreshes the display. It never touches the disk.
+
+A drive poll runs on a worker thread and the passes go on while it waits: a drive that
+stops answering keeps its driver in time-outs and retries (3 × 0.25 s), and the gauge
+rules must be evaluated meanwhile. Every other drive call waits for the poll in flight
+first (``settle``), so the drive is only ever used by one thread at a time.
 """
 
 from __future__ import annotations
@@ -16,6 +21,8 @@ import threading
 import time
 from collections import deque
 from collections.abc import Iterator
+from concurrent.futures import Future, ThreadPoolExecutor
+from concurrent.futures import wait as wait_for
 
 import numpy as np
 from numpy.typing import NDArray
@@ -29,6 +36,16 @@ from labstand.session.safety import EStopError, SafetyLimits, SafetyMonitor
 from recordings.schema import concat_blocks
 
 log = logging.getLogger(__name__)
+
+#: How long a pass waits for a poll it has just sent before going on (a drive that
+#: answers does so in a few ms; one that does not is collected by a later pass), s.
+PROMPT_ANSWER_S = 0.02
+#: An e-stop waits this long for a poll in flight before it gives the drive up as not
+#: answering (then its watchdog, not a disable, stops it), s.
+STOP_SETTLE_S = 0.1
+#: A drive that has not answered a poll for this long is an e-stop, whatever its driver's
+#: retries would still try (3 × 0.25 s): two of its time-outs, s (docs/acquisition.md).
+DRIVE_ANSWER_S = 0.5
 
 __all__ = ["SessionLoop"]
 
@@ -80,6 +97,9 @@ class SessionLoop:
         self._start_s: float | None = None  # host time the profile started
         self._seen = GaugeStats()
         self._checked_stats_s = 0.0
+        self._poller: ThreadPoolExecutor | None = None
+        self._inflight: Future[DriveState] | None = None
+        self._sent_s = 0.0  # when the poll in flight was sent
 
     # ---- one pass --------------------------------------------------------------------
     def _read(self, timeout_s: float) -> NDArray[np.void] | None:
@@ -103,9 +123,20 @@ class SessionLoop:
         if self._checking:
             self.monitor.check_silence(now - self._last_data_s)
         self._polled = False
-        if now >= self._next_poll and self.drive_ok:
+        if self._inflight is None and now >= self._next_poll and self.drive_ok:
             self._next_poll = max(self._next_poll + self.period_s, now)
+            if self._poller is None:
+                self._poller = ThreadPoolExecutor(1, thread_name_prefix="drive poll")
+            self._inflight, self._sent_s = self._poller.submit(self.drive.poll), now
+            wait_for([self._inflight], timeout=PROMPT_ANSWER_S)
+        if self._inflight is not None and self._inflight.done():
             self._poll(expect_active)
+        elif self._inflight is not None and time.monotonic() - self._sent_s > DRIVE_ANSWER_S:
+            self.drive_ok = False
+            raise EStopError(
+                f"the drive did not answer: {self.drive.name} gave no reply to a poll "
+                f"within {DRIVE_ANSWER_S:g} s"
+            )
         self._show()
 
     def _on_gauges(self, block: NDArray[np.void]) -> None:
@@ -123,8 +154,11 @@ class SessionLoop:
             self.monitor.check_block(block)
 
     def _poll(self, expect_active: bool) -> None:
+        """Take the answer of the poll in flight (it is done)."""
+        assert self._inflight is not None
+        answer, self._inflight = self._inflight, None
         try:
-            state = self.drive.poll()
+            state = answer.result()
         except DriveError as err:
             self.drive_ok = False
             raise EStopError(f"the drive did not answer: {err}") from err
@@ -154,6 +188,23 @@ class SessionLoop:
                 raise EStopError(f"{self.drive.name} did not enable within {timeout_s:g} s")
             self._pass(expect_active=False)
 
+    def settle(self, timeout_s: float | None = None) -> None:
+        """Wait for the poll in flight before another drive call (the driver is not shared).
+
+        Its answer is dropped; a drive that failed it, or that has not answered within
+        ``timeout_s`` (None: the driver's own time-outs), is marked as not answering.
+        """
+        if self._inflight is None:
+            return
+        answer, self._inflight = self._inflight, None
+        if not wait_for([answer], timeout=timeout_s).done:
+            self.drive_ok = False  # in its retries: the worker ends them, nobody waits
+            return
+        try:
+            answer.result()
+        except (DriveError, ClosedError):
+            self.drive_ok = False
+
     @contextlib.contextmanager
     def keepalive(self, period_s: float = 0.25) -> Iterator[None]:
         """Poll the drive from a thread while the caller waits (for a confirmation).
@@ -161,6 +212,7 @@ class SessionLoop:
         An orderly run stands the watchdog down at its end, but another controller may
         have left it armed; without polls it would trip while the operator reads.
         """
+        self.settle()
         done = threading.Event()
 
         def loop() -> None:
@@ -183,19 +235,25 @@ class SessionLoop:
     def disable(self) -> bool:
         """Disable the drive at once; True if it acknowledged."""
         self.phase = "disabled"
+        self.settle(STOP_SETTLE_S)
         if self.drive.closed:
             return self.drive_disabled
+        if not self.drive_ok:  # its time-outs would only delay the stop: the watchdog trips it
+            self.disable_error = "the drive does not answer (its watchdog disables it)"
+            return False
         try:
             self.drive.disable()
         except (DriveError, ClosedError) as err:
             self.disable_error = str(err)
-            log.error("could not disable the drive: %s", err)
+            # the run's last line says so; the driver's reason goes to the log (-v)
+            log.info("could not disable the drive: %s", err)
             return False
         self.drive_disabled, self.disable_error = True, ""
         return True
 
     def stand_down(self) -> bool:
         """Disable the drive and release its watchdog (it stays healthy); True if done."""
+        self.settle()
         if self.drive.closed or not self.drive_ok:
             return False
         try:
@@ -214,9 +272,12 @@ class SessionLoop:
         told: its watchdog trips it, and the next pre-flight reports that trip.
         """
         try:
+            self.settle()
             if not self.drive.closed and self.drive_ok and not self.stand_down():
                 self.disable()
         finally:
+            if self._poller is not None:
+                self._poller.shutdown(wait=True)
             self.drive.close()
             self.gauges.close()
 

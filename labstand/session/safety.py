@@ -22,11 +22,27 @@ from numpy.typing import NDArray
 
 from drivers.interfaces import DriveState
 
-__all__ = ["EStopError", "SafetyLimits", "SafetyMonitor"]
+__all__ = ["SAFETY_MAXIMA", "EStopError", "SafetyLimits", "SafetyMonitor"]
 
 
 class EStopError(Exception):
     """A reason to stop the stand at once; ``str(err)`` is the one-line reason."""
+
+
+#: The largest value of each threshold that keeps its rule meaningful [estimate]:
+#: x may leave 0 … A by at most 10 mm (the 90 mm stroke ends 2 mm before the drive's
+#: over-travel trip: a wider margin stops nothing the trip would not); the speed by at
+#: most 50 %; the slack threshold stays below the light weight's 17 N rest tension; slack
+#: may last at most 1 s (a weight falling 1 s has left its guide); the gauges may be
+#: silent at most 1 s (50 frames: a slower rule let a silent stream end "Done", with
+#: a third of the motion recorded).
+SAFETY_MAXIMA = {
+    "position_margin_mm": 10.0,
+    "speed_margin": 0.5,
+    "slack_force_n": 15.0,
+    "slack_max_s": 1.0,
+    "gauge_timeout_s": 1.0,
+}
 
 
 @dataclass(frozen=True)
@@ -62,6 +78,11 @@ class SafetyLimits:
             value = getattr(self, name)
             if not (np.isfinite(value) and value > 0):
                 raise ValueError(f"safety limit {name} must be > 0, got {value:g}")
+            if value > SAFETY_MAXIMA[name]:
+                raise ValueError(
+                    f"safety limit {name} must be ≤ {SAFETY_MAXIMA[name]:g}, got {value:g} "
+                    "(beyond it the rule would no longer stop the stand in time)"
+                )
 
     def describe(self, x_range_mm: tuple[float, float], speed_max_m_s: float) -> str:
         """One line for the run's summary."""

@@ -69,13 +69,19 @@ class Outcome(StrEnum):
 
 
 class StopRequest:
-    """Ctrl-C presses, counted by a signal handler and read by the loop."""
+    """Stop requests (Ctrl-C, SIGTERM), counted by a signal handler and read by the loop.
+
+    ``by`` names the first one as it came ("Ctrl-C" or "SIGTERM"), for the messages.
+    """
 
     def __init__(self) -> None:
         self.presses = 0
+        self.by = "Ctrl-C"
 
-    def press(self) -> None:
-        """One more Ctrl-C (safe to call from a signal handler)."""
+    def press(self, by: str = "Ctrl-C") -> None:
+        """One more request (safe to call from a signal handler)."""
+        if not self.presses:
+            self.by = by
         self.presses += 1
 
 
@@ -190,12 +196,15 @@ class Session(SessionLoop):
         """
         self._drain()
         try:
+            self.settle()
             self.drive.enable()
             self._wait_active()
             if pre.needs_home:
                 self.phase = "homing"
+                self.settle()
                 self.drive.home()
                 self._until_done(stop, "homing")
+                self.settle()
                 self.profile = self.drive.load_profile(pre.profile.spec)
         except (EStopError, DriveError) as err:
             self.disable()
@@ -206,7 +215,7 @@ class Session(SessionLoop):
         while True:
             self._pass(expect_active=True)
             if stop.presses:
-                raise EStopError(f"Ctrl-C while {what}")
+                raise EStopError(f"{stop.by} while {what}")
             if self._polled and self.state is not None:
                 if self.state.profile_state is ProfileState.DONE:
                     return
@@ -230,15 +239,15 @@ class Session(SessionLoop):
         except (EStopError, DriveError) as err:
             reason = str(err)
             log.info("e-stop: %s", reason)
+            self._event("estop", reason)  # the moment the rule fired, before the disable
             self.disable()
-            self._event("estop", reason)
         else:
             self.disable()
         self._tail()
         if outcome is Outcome.STOPPED and stop.presses >= 2 and "immediate" not in reason:
             # the second press came once the controlled stop was done: what the terminal
             # said ("disabling the drive at once") is what the recording and the end say
-            outcome, reason = self._immediate(after=reason)
+            outcome, reason = self._immediate(stop, after=reason)
         self._show(force=True)
         return RunResult(
             outcome,
@@ -251,6 +260,7 @@ class Session(SessionLoop):
         )
 
     def _run_profile(self, stop: StopRequest, title: str) -> tuple[Outcome, str]:
+        self.settle()
         t_a = time.monotonic()
         self.drive.start()
         self._start_s = (t_a + time.monotonic()) / 2
@@ -260,7 +270,7 @@ class Session(SessionLoop):
         while True:
             self._pass(expect_active=True)
             if stop.presses >= 2:
-                return self._immediate()
+                return self._immediate(stop)
             if stop.presses:
                 return self._controlled_stop(stop)
             if self.pipe is not None and self.pipe.error is not None:
@@ -274,24 +284,25 @@ class Session(SessionLoop):
                     name = state.name.lower()
                     raise EStopError(f"the drive program stopped the profile (state {name})")
 
-    def _immediate(self, after: str = "") -> tuple[Outcome, str]:
+    def _immediate(self, stop: StopRequest, after: str = "") -> tuple[Outcome, str]:
         self.disable()
-        reason = f"Ctrl-C twice at {self._elapsed():.2f} s: immediate disable"
+        reason = f"{stop.by} twice at {self._elapsed():.2f} s: immediate disable"
         if after:
             reason = f"{after}, then {reason}"
         self._event("estop", reason)
         return Outcome.STOPPED, reason
 
     def _controlled_stop(self, stop: StopRequest) -> tuple[Outcome, str]:
-        reason = f"Ctrl-C at {self._elapsed():.2f} s: controlled stop"
+        reason = f"{stop.by} at {self._elapsed():.2f} s: controlled stop"
         self.phase, self.monitor.running = "stopping", False
+        self.settle()
         self.drive.stop()
         self._event("stop", reason)
         deadline = time.monotonic() + STOP_TIMEOUT_S
         while True:
             self._pass(expect_active=True)
             if stop.presses >= 2:
-                return self._immediate()
+                return self._immediate(stop)
             st = self.state
             if (
                 self._polled

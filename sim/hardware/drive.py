@@ -31,7 +31,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from drivers import unidrive_registers as pr
-from drivers.limits import DriveLimits, LimitError
+from drivers.limits import DriveLimits, InvalidSignalError, LimitError
 from drivers.signals import plan_motion
 from drivers.unidrive_profile import ProfileState, RejectReason, ShapeCode, decode_profile
 from drivers.unidrive_registers import ControlBit, Register, StatusBit, TripCode
@@ -293,6 +293,10 @@ class SimulatedDrive:
             return
         try:
             planned: Motion = plan_motion(spec, self.limits)
+        except InvalidSignalError as err:  # no motion at all (0 cycles, NaN, ...)
+            log.info("simulated drive refuses a profile: %s", err)
+            self._reject(RejectReason.BAD_VALUE)
+            return
         except LimitError as err:
             bad = (
                 spec.amplitude_m <= 0

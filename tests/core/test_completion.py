@@ -38,4 +38,8 @@ def test_bash_completes_commands_options_and_files(tmp_path: Path) -> None:
     assert complete(script, tmp_path, "di") == ["diagnose", "diagnose-check"]
     assert complete(script, tmp_path, "run", "--op") == ["--operator"]
     assert complete(script, tmp_path, "info", "run-") == ["run-1.mcap", "run-2.h5"]
-    assert complete(script, tmp_path, "diagnose-check", "--truth", "") == ["other", "outside", "same"]
+    assert complete(script, tmp_path, "diagnose-check", "--truth", "") == [
+        "other",
+        "outside",
+        "same",
+    ]

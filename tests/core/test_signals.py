@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 
-from drivers.limits import DriveLimits, LimitError
+from drivers.limits import DriveLimits, InvalidSignalError, LimitError
 from drivers.signals import Shape, SignalSpec, plan_motion
 
 LIMITS = DriveLimits()
@@ -81,7 +83,6 @@ def test_rectangular_step_becomes_the_time_optimal_move() -> None:
             SignalSpec(Shape.TRAPEZOIDAL, 0.095, 0.5),
             "amplitude 95 mm exceeds the drive limit 90 mm",
         ),
-        (SignalSpec(Shape.TRAPEZOIDAL, 0.0, 0.5), "amplitude must be > 0 mm"),
         (SignalSpec(Shape.TRAPEZOIDAL, 0.09, 5.0, ramp_fraction=0.1), "ramp speed 4.5 m/s exceeds"),
         (SignalSpec(Shape.QUASI_SINUSOIDAL, 0.09, 3.0), "peak acceleration 15.99 m/s²"),
         (SignalSpec(Shape.QUASI_SINUSOIDAL, 0.02, 16.0), "peak speed 1.005 m/s exceeds"),
@@ -91,15 +92,49 @@ def test_rectangular_step_becomes_the_time_optimal_move() -> None:
             SignalSpec(Shape.TRAPEZOIDAL, 0.06, 2.0, ramp_fraction=0.15),
             "needs 80 ms to change speed",
         ),
-        (SignalSpec(Shape.TRAPEZOIDAL, 0.05, -1.0), "frequency must be > 0 Hz"),
-        (SignalSpec(Shape.TRAPEZOIDAL, 0.05, 1.0, cycles=0), "cycles must be ≥ 1"),
-        (SignalSpec(Shape.TRAPEZOIDAL, 0.05, 1.0, ramp_fraction=0.7), "ramp fraction must lie in"),
+        (SignalSpec(Shape.TRAPEZOIDAL, 0.05, 1e-9), "frequency 1e-09 Hz is below the drive's"),
+        (SignalSpec(Shape.TRAPEZOIDAL, 0.05, 1.0, cycles=10**9), "1000000000 cycles exceed"),
+        (SignalSpec(Shape.TRAPEZOIDAL, 0.05, 1.0, cycles=30_000), "profile clock (Pr 20.34) wraps"),
+        (
+            SignalSpec(Shape.TRAPEZOIDAL, 0.05, 1.0, dwell_end_s=1e9),
+            "dwell_end_s 1e+09 s exceeds the drive's 2147 s",
+        ),
+        (
+            SignalSpec(Shape.TRAPEZOIDAL, 0.05, 0.01, cycles=200, dwell_start_s=2000),
+            "the motion lasts 22001 s",
+        ),
     ],
 )
 def test_commands_beyond_the_limits_are_refused_with_the_limit(
     spec: SignalSpec, message: str
 ) -> None:
-    with pytest.raises(LimitError, match=message.replace("(", r"\(").replace(".", r"\.")):
+    with pytest.raises(LimitError, match=re.escape(message)):
+        plan_motion(spec, LIMITS)
+
+
+NAN, INF = float("nan"), float("inf")
+
+
+@pytest.mark.parametrize(
+    ("spec", "message"),
+    [
+        (SignalSpec(Shape.TRAPEZOIDAL, 0.0, 0.5), "amplitude must be > 0 mm"),
+        (SignalSpec(Shape.TRAPEZOIDAL, -0.02, 0.5), "amplitude must be > 0 mm, got -20 mm"),
+        (SignalSpec(Shape.TRAPEZOIDAL, NAN, 0.5), "amplitude must be > 0 mm, got nan mm"),
+        (SignalSpec(Shape.TRAPEZOIDAL, 0.05, -1.0), "frequency must be > 0 Hz"),
+        (SignalSpec(Shape.TRAPEZOIDAL, 0.05, 0.0), "frequency must be > 0 Hz"),
+        (SignalSpec(Shape.TRAPEZOIDAL, 0.05, INF), "frequency must be > 0 Hz, got inf"),
+        (SignalSpec(Shape.TRAPEZOIDAL, 0.05, 1.0, cycles=0), "cycles must be ≥ 1"),
+        (SignalSpec(Shape.TRAPEZOIDAL, 0.05, 1.0, ramp_fraction=0.7), "ramp fraction must lie in"),
+        (SignalSpec(Shape.TRAPEZOIDAL, 0.05, 1.0, dwell_start_s=NAN), "dwell_start_s must be a"),
+        (SignalSpec(Shape.TRAPEZOIDAL, 0.05, 1.0, dwell_end_s=INF), "dwell_end_s must be a"),
+        (SignalSpec(Shape.TRAPEZOIDAL, 0.05, 1.0, dwell_end_s=-1), "dwell_end_s must be a"),
+    ],
+)
+def test_values_that_describe_no_motion_are_bad_input_not_limits(
+    spec: SignalSpec, message: str
+) -> None:
+    with pytest.raises(InvalidSignalError, match=re.escape(message)):
         plan_motion(spec, LIMITS)
 
 

@@ -6,14 +6,17 @@ from pathlib import Path
 
 import pytest
 
-from sim.config import MAX_NESTING, ConfigError, load_config
+from sim.config import MAX_NESTING, MAX_STAND_FILE_BYTES, ConfigError, load_config
 
 TOO_DEEP = MAX_NESTING + 1
 
 BAD = [
     (f"[drive]\nspeed_max_m_s = {'[' * 5000}{']' * 5000}\n", "line 2: arrays or tables nested"),
     (f"a = {'{ b = ' * TOO_DEEP}1{' }' * TOO_DEEP}\n", "line 1: arrays or tables nested"),
-    ("a" + ".b" * 5000 + " = 1\n", "key a.b.b.b"),
+    ("a" + ".b" * 5000 + " = 1\n", "line 1: arrays or tables nested"),  # before tomllib
+    ("x = 1\n[a" + ".b" * TOO_DEEP + "]\n", "line 2: arrays or tables nested"),
+    ("[acquisition]\nsample_rate_hz = 1e12\n", "sample_rate_hz: must be ≤ 100000, got 1e+12"),
+    ("[acquisition]\nsample_rate_hz = 1e308\n", "sample_rate_hz: must be ≤ 100000"),
     (f"[drive]\nspeed_max_m_s = {10**400}\n", "[drive] speed_max_m_s: must be a number in range"),
     (f"[weights_kg]\nheavy = -{10**400}\n", "[weights_kg] heavy: must be a number in range"),
     (f"[drive]\nspeed_max_m_s = {'9' * 5000}\n", "not valid TOML: Exceeds the limit (4300"),
@@ -23,6 +26,13 @@ BAD = [
     (f'[weight]\ndefault = "{"x" * 500}"\n', "names no weight in [weights_kg]"),
     ("[drive]\nspeed_max_m_s = [" + "1, " * 500 + "1]\n", "must be a number, got list [1, 1, 1,"),
 ]
+
+
+def test_a_stand_file_larger_than_a_megabyte_is_refused_before_it_is_read(tmp_path: Path) -> None:
+    path = tmp_path / "stand.toml"
+    path.write_text("# padding\n" * (MAX_STAND_FILE_BYTES // 10 + 1))
+    with pytest.raises(ConfigError, match="larger than a stand file can be"):
+        load_config(path)
 
 
 @pytest.mark.parametrize(("content", "message"), BAD)
@@ -37,6 +47,18 @@ def test_a_bad_stand_file_is_one_short_line_naming_the_key(
     assert text.startswith(f"{path}: ")
     assert message in text
     assert "\n" not in text and len(text) < 700
+
+
+def test_dots_of_numbers_and_strings_are_not_nesting(tmp_path: Path) -> None:
+    path = tmp_path / "stand.toml"
+    dots = ".".join("abcdefghijklmnopqrstu")
+    path.write_text(
+        f"drive.speed_max_m_s = 0.75  # {dots}\n"
+        f'[devices]\ndrive = "tcp://{dots}:502"\ngauges = "/dev/ttyUSB0"\n'
+    )
+    config = load_config(path)
+    assert config.drive.speed_max_m_s == 0.75
+    assert config.devices is not None and config.devices.drive == f"tcp://{dots}:502"
 
 
 def test_brackets_in_strings_and_comments_are_not_nesting(tmp_path: Path) -> None:
