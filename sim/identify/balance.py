@@ -30,7 +30,7 @@ from numpy.typing import NDArray
 from scipy.ndimage import median_filter
 from scipy.signal import butter, sosfiltfilt
 
-from sim.identify.heldout import BLOCK_S, Outputs
+from sim.identify.heldout import Outputs, held_out_blocks
 from sim.identify.signature import (
     DRIFT_ORDERS,
     POSITION_ORDERS,
@@ -281,17 +281,6 @@ class BalanceFit:
 _ROUTES = {"u+F": {"weight", "tension"}, "u": {"u"}, "F": {"F"}}
 
 
-def _blocks(tr: Trace) -> list[NDArray[np.intp]]:
-    """The held-out blocks as ``heldout.block_errors`` cuts them (sample indices)."""
-    idx = tr.test
-    out: list[NDArray[np.intp]] = []
-    for cyc in np.unique(tr.cycle[idx]):
-        samples = np.flatnonzero(idx & (tr.cycle == cyc))
-        pieces = max(1, int(samples.size // (BLOCK_S * tr.rate_hz)))
-        out += list(np.array_split(samples, pieces))
-    return out
-
-
 def fit_balances(
     traces: Sequence[Trace],
     outputs: Sequence[Outputs],
@@ -379,7 +368,7 @@ def _block_errors(
             f_fit = f_fit + base_coef @ bf
         rg = np.where(b.use_g, (b.g - g_fit) / b.noise_g, np.nan)
         rf = np.where(b.use_f, (b.f - f_fit) / b.noise_f, np.nan)
-        for sel in _blocks(tr):
+        for sel in held_out_blocks(tr):
             # The two balances pooled as a geometric mean (as ``heldout_excess`` pools
             # channels): each counts by how much a term improves it, not by its samples'
             # count. Pooled as one mean, the taut fibre's law (most samples) diluted an

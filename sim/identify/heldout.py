@@ -137,20 +137,28 @@ def block_errors(
             _noise_scale(tr.u_m[idx], tr.noise_u_m),
             _noise_scale(tr.force_n[idx], tr.noise_force_n),
         ]
-        for c in np.unique(tr.cycle[idx]):
-            samples = np.flatnonzero(idx & (tr.cycle == c))
-            pieces = max(1, int(samples.size // (block_s * tr.rate_hz)))
-            for sel in np.array_split(samples, pieces):
-                eb, ea = 0.0, 0.0
-                for rec, sb, sa, scale in (
-                    (tr.u_m, b.u_m, a.u_m, scales[0]),
-                    (tr.force_n, b.force_n, a.force_n, scales[1]),
-                ):
-                    eb += float(np.mean((sb[sel] - rec[sel]) ** 2)) / scale**2
-                    ea += float(np.mean((sa[sel] - rec[sel]) ** 2)) / scale**2
-                errors.append((eb, ea))
+        for sel in held_out_blocks(tr, block_s):
+            eb, ea = 0.0, 0.0
+            for rec, sb, sa, scale in (
+                (tr.u_m, b.u_m, a.u_m, scales[0]),
+                (tr.force_n, b.force_n, a.force_n, scales[1]),
+            ):
+                eb += float(np.mean((sb[sel] - rec[sel]) ** 2)) / scale**2
+                ea += float(np.mean((sa[sel] - rec[sel]) ** 2)) / scale**2
+            errors.append((eb, ea))
     pairs = np.asarray(errors, dtype=np.float64).reshape(-1, 2)
     return pairs[:, 0], pairs[:, 1]
+
+
+def held_out_blocks(trace: Trace, block_s: float = BLOCK_S) -> list[NDArray[np.intp]]:
+    """The held-out samples cut into blocks: each held-out cycle in pieces of ``block_s``."""
+    idx = trace.test
+    blocks: list[NDArray[np.intp]] = []
+    for c in np.unique(trace.cycle[idx]):
+        samples = np.flatnonzero(idx & (trace.cycle == c))
+        pieces = max(1, int(samples.size // (block_s * trace.rate_hz)))
+        blocks += np.array_split(samples, pieces)
+    return blocks
 
 
 def block_improvements(
