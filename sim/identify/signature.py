@@ -151,17 +151,18 @@ def _taut_filters(
     n = nominal.projection
     k = nominal.stiffness_n_m * values.get("stiffness_scale", 1.0)
     c = nominal.damping_n_s_m * values.get("damping_scale", 1.0)
-    den = [mass_kg, n * n * c, n * n * k]
-    systems = {
-        "weight": ([1.0], np.polymul([-n * c, -n * k], [1.0])),
-        "tension": ([n], np.polyadd([mass_kg, 0.0, 0.0], [0.0, 0.0, 0.0])),
+    den = [mass_kg, n * n * c, n * n * k]  # m·s² + n²c·s + n²k
+    systems = {  # (δu, δF) numerators over den
+        "weight": ([1.0], [-n * c, -n * k]),  # δF = −n(k + c·s)·H·f
+        "tension": ([n], [mass_kg, 0.0, 0.0]),  # δF = g − n²(k + c·s)·H·g = m·s²·H·g
     }
     out = {}
     for route, (num_u, num_f) in systems.items():
         pair = []
         for num in (num_u, num_f):
-            b, a, _ = cont2discrete((np.asarray(num, float), np.asarray(den, float)),
-                                    1.0 / rate_hz, method="bilinear")  # fmt: skip
+            b, a, _ = cont2discrete(
+                (np.asarray(num, float), np.asarray(den, float)), 1.0 / rate_hz, method="bilinear"
+            )
             pair.append((np.ravel(b), np.ravel(a)))
         out[route] = (pair[0], pair[1])
     return out
