@@ -165,7 +165,10 @@ def _remainder_plot(path: Path, traces: Sequence[Trace], result: Diagnosis) -> b
     in grey, the signature's fit in colour, held-out cycles shaded.
     """
     rem = result.remainder
-    passing = [s for s in rem.signature if s.passes] if rem is not None else []
+    # The model's outputs' signatures: the balances' describe forces, not these channels.
+    passing = (
+        [s for s in rem.signature if s.passes and s.source == "outputs"] if rem is not None else []
+    )
     if rem is None or not passing:
         return False
     best = passing[0]

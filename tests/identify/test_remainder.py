@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 import dataclasses
+from pathlib import Path
 
 import numpy as np
 import pytest
 from scipy.signal import lfilter
 
+from labstand.diagnosis_report import write_report
 from sim.config import StandConfig
 from sim.identify import diagnose, make_trace
 from sim.identify.check import CaseSpec, make_campaign, recording_set
@@ -65,7 +67,7 @@ def clean_heavy(stand: StandConfig) -> list[Trace]:
 
 
 def test_a_drifting_force_zero_is_described_as_drift_in_the_force_channel(
-    stand: StandConfig, clean_heavy: list[Trace]
+    stand: StandConfig, clean_heavy: list[Trace], tmp_path: Path
 ) -> None:
     traces = [
         dataclasses.replace(
@@ -80,9 +82,14 @@ def test_a_drifting_force_zero_is_described_as_drift_in_the_force_channel(
     assert result.remainder is not None and result.remainder.beyond_noise
     passing = [s for s in result.remainder.signature if s.passes]
     assert (passing[0].kind, passing[0].channel) == ("drift", "F")
+    assert passing[0].source == "balances"
     # In the model's outputs too, where it closes most of the remainder.
     outputs = next(s for s in passing if s.source == "outputs" and s.kind == "drift")
     assert outputs.channel == "F" and outputs.closes > 0.5
+    # The report shows it: the remainder against the drift term's fit.
+    index = write_report(tmp_path / "report", traces, result)
+    assert (tmp_path / "report" / "remainder.png").stat().st_size > 0
+    assert "unexplained" in index.read_text(encoding="utf-8")
 
 
 @pytest.mark.parametrize("noise_scale", [0.3, 1.0, 3.0])
