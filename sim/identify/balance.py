@@ -299,24 +299,23 @@ def fit_balances(
     ]
     library = _BalanceLibrary(traces, balances, nominal, values)
 
-    def design(kind: str, which: str) -> tuple[list[_Column], FloatArray, FloatArray]:
-        """Columns (terms × samples) and target over the chosen samples of every trace."""
+    def training(kind: str) -> tuple[list[_Column], FloatArray, FloatArray]:
+        """Columns (terms × samples) and target over the training samples of every trace."""
         cols, target = [], []
         names: list[_Column] = []
         for i, (tr, b) in enumerate(zip(traces, balances, strict=True)):
             names, g_cols, f_cols = library.columns(kind, i)
-            part = tr.train if which == "train" else np.ones(tr.samples, dtype=bool)
-            sg, sf = part & b.use_g, part & b.use_f
+            sg, sf = tr.train & b.use_g, tr.train & b.use_f
             cols.append(np.hstack([g_cols[:, sg] / b.noise_g, f_cols[:, sf] / b.noise_f]))
             target.append(np.concatenate([b.g[sg] / b.noise_g, b.f[sf] / b.noise_f]))
         return names, np.hstack(cols), np.concatenate(target)
 
-    base_names, base_train, target = design("base", "train")
+    base_names, base_train, target = training("base")
     base_coef = stlsq(base_train.T, target, 0.0, np.ones(len(base_names), dtype=bool))
     before = _block_errors(traces, balances, library, "base", base_coef)
     fits = []
     for kind in dict.fromkeys(k for k, _ in BALANCE_VARIANTS):
-        names, train, _ = design(kind, "train")
+        names, train, _ = training(kind)
         for variant, channel in BALANCE_VARIANTS:
             if variant != kind:
                 continue
