@@ -10,10 +10,12 @@ from sim.identify.heldout import Outputs
 from sim.identify.remainder import Remainder
 from sim.identify.where import Where
 
-__all__ = ["AcceptedEffect", "ChannelGap", "Diagnosis", "RankedEffect"]
+__all__ = ["AcceptedEffect", "ChannelGap", "Diagnosis", "Intervals", "RankedEffect"]
 
 #: Per channel (``u``, ``F``): R, psi and NRMSE on the held-out samples.
 ChannelGap = dict[str, dict[str, float]]
+#: A 95 % interval per parameter: ``{name: (low, high)}``.
+Intervals = dict[str, tuple[float, float]]
 
 
 @dataclass
@@ -70,14 +72,17 @@ class AcceptedEffect:
     params: dict[str, float]
     at_bound: list[str] = field(default_factory=list)
     indistinguishable_from: list[str] = field(default_factory=list)
+    #: 95 % intervals of ``params`` (the method: ``Diagnosis.interval_method``).
+    intervals: Intervals = field(default_factory=dict)
 
     def to_dict(self) -> dict[str, object]:
-        """JSON keys effect, closure, p_value, params, at_bound, indistinguishable_from."""
+        """JSON keys effect, closure, p_value, params, intervals, at_bound, ..."""
         return {
             "effect": self.effect,
             "closure": self.closure,
             "p_value": self.p_value,
             "params": self.params,
+            "intervals": _listed(self.intervals),
             "at_bound": self.at_bound,
             "indistinguishable_from": self.indistinguishable_from,
         }
@@ -110,6 +115,19 @@ class Diagnosis:
     #: Effects that passed their test but did no better than a signature of the
     #: remainder (effect → the signature's kind): not named.
     displaced: dict[str, str] = field(default_factory=dict)
+    #: 95 % intervals of ``baseline`` (stiffness_scale, damping_scale, friction_scale).
+    baseline_intervals: Intervals = field(default_factory=dict)
+    gap_closure_interval: tuple[float, float] | None = None
+    #: Per channel, the held-out NRMSE's 95 % interval before and after the named effects:
+    #: ``{"before": {"u": (lo, hi), "F": ...}, "after": {...}}``.
+    gap_intervals: dict[str, Intervals] = field(default_factory=dict)
+    #: How the intervals were found, in words.
+    interval_method: str = ""
+    #: Parameters fitted per recording: ``{name: {"params": {...}, "intervals": {...},
+    #: "drive_rate_hz": f, "amplitude_m": a, "mass_kg": m}}``.
+    per_recording: dict[str, dict[str, Any]] = field(default_factory=dict)
+    #: Do the per-recording fits agree: ``{parameter: {"p_value": p, "trend": words|None}}``.
+    consistency: dict[str, dict[str, Any]] = field(default_factory=dict)
 
     @property
     def effect(self) -> str:
@@ -137,4 +155,17 @@ class Diagnosis:
             "confidence": self.confidence,
             "simulations": self.simulations,
             "timings_s": self.timings_s,
+            "baseline_intervals": _listed(self.baseline_intervals),
+            "gap_closure_interval": (
+                list(self.gap_closure_interval) if self.gap_closure_interval else None
+            ),
+            "gap_intervals": {k: _listed(v) for k, v in self.gap_intervals.items()},
+            "interval_method": self.interval_method,
+            "per_recording": self.per_recording,
+            "consistency": self.consistency,
         }
+
+
+def _listed(intervals: Intervals) -> dict[str, list[float]]:
+    """JSON has no tuples: each interval as ``[low, high]``."""
+    return {name: [float(lo), float(hi)] for name, (lo, hi) in intervals.items()}
