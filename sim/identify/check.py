@@ -221,11 +221,12 @@ def make_campaign(
     nominal = stand.stand_params("final", mass_kg)
     real = draw_real_stand(nominal, rng)
     effects: list[EffectSpec] = []
-    params: dict[str, float] = {}
+    # The true baseline multipliers too: what the diagnosis's intervals must hold.
+    params: dict[str, float] = true_scales(nominal, real)
     if truth != "none":
         spec = EffectSpec(truth, EFFECTS[truth].draw(rng))
         effects = [spec]
-        params = dict(spec.params)
+        params.update({f"{truth}.{k}": v for k, v in spec.resolved().items()})
     noise = NoiseSpec.draw(rng)
     traces, oracle = [], []
     for item in campaign:
@@ -252,6 +253,15 @@ def make_campaign(
     return traces, oracle, params
 
 
+def true_scales(nominal: StandParams, real: StandParams) -> dict[str, float]:
+    """The drawn stand's stiffness, damping and friction as the fit's multipliers."""
+    return {
+        "stiffness_scale": real.stiffness_n_m / nominal.stiffness_n_m,
+        "damping_scale": real.damping_n_s_m / nominal.damping_n_s_m,
+        "friction_scale": real.friction_scale / nominal.friction_scale,
+    }
+
+
 def _oracle(
     trace: Trace, nominal: StandParams, real: StandParams, effects: Sequence[EffectSpec]
 ) -> Outputs:
@@ -261,11 +271,7 @@ def _oracle(
     candidates, so "how far the true model shrinks the gap" compares like with like (an
     open-loop run of the truth knows no restart error at all).
     """
-    values = {
-        "stiffness_scale": real.stiffness_n_m / nominal.stiffness_n_m,
-        "damping_scale": real.damping_n_s_m / nominal.damping_n_s_m,
-        "friction_scale": real.friction_scale / nominal.friction_scale,
-    }
+    values = true_scales(nominal, real)
     for spec in effects:
         values.update({f"{spec.name}.{k}": v for k, v in spec.resolved().items()})
     if "dial_gauge_calibration.offset_m" in values:  # a trace counts u from its rest value

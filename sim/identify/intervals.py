@@ -1,0 +1,215 @@
+"""How sure: 95 % intervals of the fitted parameters and of the held-out gap.
+
+Parameters: the fit's Gauss–Newton linearisation at its optimum with a covariance that is
+robust to what these fits have — errors correlated over a stretch of samples (a slack
+or snatch event moves many samples together) and a model that is never exact — the
+cluster-robust "sandwich" A⁻¹BA⁻¹ over training blocks of about ``BLOCK_S`` (A = JᵀJ,
+B = Σ_blocks (J_bᵀr_b)(J_bᵀr_b)ᵀ), the held-out test's unit of independence, with the
+small-sample factor G/(G−1) and Student's t on G−1 degrees of freedom for G blocks.
+It costs one batch of simulations (the Jacobian). Intervals are built in the
+optimiser's coordinates (log for the scales, so they are asymmetric in natural units),
+cut at the physical range and marked where they reach it: there the data cannot say how
+far beyond the range the parameter would go. Counts and scanned thresholds are held at
+their level (no derivative exists); their interval is the level itself.
+
+The gap (held-out NRMSE per channel, before and after; the share of the gap closed): a
+bootstrap over held-out blocks (as the decision's test cuts them) within each recording,
+no refit: the uncertainty of *how far* the gap shrinks given the fitted models.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy import stats
+
+from sim.identify.fitting import Candidate, Objective, scored_samples
+from sim.identify.heldout import BLOCK_S, Outputs, _noise_scale, held_out_blocks
+from sim.identify.report import Intervals
+from sim.identify.traces import Trace
+from sim.params import StandParams
+
+FloatArray = NDArray[np.float64]
+
+LEVEL = 0.95
+#: What the report says of the method.
+PARAMETER_METHOD = (
+    "parameters: Gauss–Newton linearisation at the optimum, cluster-robust (sandwich) "
+    "covariance over 0.25 s training blocks, Student t on blocks − 1 degrees of freedom"
+)
+GAP_METHOD = "gap and closure: bootstrap over 0.25 s held-out blocks within each recording"
+BOOTSTRAP_ROUNDS = 1000
+
+
+@dataclass
+class ParameterIntervals:
+    """Intervals of one fit (natural units) and which of them reach their physical bound."""
+
+    intervals: Intervals = field(default_factory=dict)
+    reaches_bound: list[str] = field(default_factory=list)
+    #: Standard errors in the optimiser's coordinates (what a consistency test compares).
+    internal_se: dict[str, float] = field(default_factory=dict)
+    simulations: int = 0
+
+
+def _block_labels(traces: Sequence[Trace], stride: int) -> NDArray[np.int64]:
+    """Each residual's training block, a label unique over traces, in ``Objective``'s order.
+
+    Blocks as the held-out test cuts them (``held_out_blocks``): each cycle (and the rest
+    before the first) in pieces of about ``BLOCK_S``, whose errors are nearly independent
+    of their neighbours'.
+    """
+    labels = []
+    offset = 0
+    for tr in traces:
+        idx = scored_samples(tr, stride)
+        own = np.zeros(idx.size, np.int64)
+        for c in np.unique(tr.cycle[idx]):
+            at = np.flatnonzero(tr.cycle[idx] == c)
+            span = int(idx[at[-1]] - idx[at[0]]) + 1
+            pieces = max(1, int(span // (BLOCK_S * tr.rate_hz)))
+            for piece in np.array_split(at, pieces):
+                own[piece] = offset
+                offset += 1
+        labels += [own, own]  # the u residuals, then the F ones
+    return np.concatenate(labels) if labels else np.zeros(0, np.int64)
+
+
+def sandwich_covariance(
+    jac: FloatArray, residuals: FloatArray, clusters: NDArray[np.int64]
+) -> tuple[FloatArray, int]:
+    """Cluster-robust covariance of a least-squares fit, and the number of clusters."""
+    bread = np.linalg.pinv(jac.T @ jac)
+    groups = np.unique(clusters)
+    scores = np.stack([jac[clusters == g].T @ residuals[clusters == g] for g in groups])
+    g = groups.size
+    meat = scores.T @ scores * (g / max(g - 1, 1))
+    return bread @ meat @ bread, g
+
+
+def parameter_intervals(
+    candidate: Candidate,
+    values: dict[str, float],
+    traces: Sequence[Trace],
+    nominal: StandParams,
+    level: float = LEVEL,
+    stride: int = 4,
+) -> ParameterIntervals:
+    """95 % intervals of a fitted candidate's parameters (see the module docstring)."""
+    objective = Objective(candidate, traces, nominal, stride)
+    z = candidate.internal(values)
+    free = np.array([p.held is None and not p.integer and not p.scan for p in candidate.params])
+    out = ParameterIntervals()
+    for p, fixed in zip(candidate.params, ~free, strict=True):
+        if fixed and p.name in values:
+            out.intervals[p.name] = (values[p.name], values[p.name])
+    if not free.any():
+        return out
+    residuals = objective.residuals(z)
+    jac = objective.jacobian(z, free)
+    out.simulations = objective.simulations
+    cov, clusters = sandwich_covariance(jac, residuals, _block_labels(traces, stride))
+    t = float(stats.t.ppf(0.5 + level / 2, max(clusters - 1, 1)))
+    free_params = [p for p, f in zip(candidate.params, free, strict=True) if f]
+    for k, p in enumerate(free_params):
+        se = math.sqrt(max(float(cov[k, k]), 0.0))
+        lo, hi = p.bounds()
+        zk = p.clipped(values[p.name])
+        z_lo, z_hi = max(zk - t * se, lo), min(zk + t * se, hi)
+        out.internal_se[p.name] = se
+        out.intervals[p.name] = (p.to_natural(z_lo), p.to_natural(z_hi))
+        edge = 2e-3 * (hi - lo)
+        if z_lo <= lo + edge or z_hi >= hi - edge:
+            out.reaches_bound.append(p.name)
+    return out
+
+
+@dataclass(frozen=True)
+class _CycleSums:
+    """Per held-out block of one trace and channel: what an NRMSE and an excess add up."""
+
+    n: FloatArray
+    rec: FloatArray
+    rec2: FloatArray
+    err_before: FloatArray
+    err_after: FloatArray
+    scale: float
+
+
+def _block_sums(trace: Trace, before: Outputs, after: Outputs) -> list[_CycleSums]:
+    """For u and F: sums over each held-out block of the trace."""
+    idx = trace.test
+    sel = held_out_blocks(trace)
+    sums = []
+    for rec, b, a, noise in (
+        (trace.u_m, before.u_m, after.u_m, trace.noise_u_m),
+        (trace.force_n, before.force_n, after.force_n, trace.noise_force_n),
+    ):
+        sums.append(
+            _CycleSums(
+                np.array([s.size for s in sel], float),
+                np.array([rec[s].sum() for s in sel]),
+                np.array([(rec[s] ** 2).sum() for s in sel]),
+                np.array([((b[s] - rec[s]) ** 2).sum() for s in sel]),
+                np.array([((a[s] - rec[s]) ** 2).sum() for s in sel]),
+                _noise_scale(rec[idx], noise),
+            )
+        )
+    return sums
+
+
+def gap_intervals(
+    traces: Sequence[Trace],
+    before: Sequence[Outputs],
+    after: Sequence[Outputs],
+    level: float = LEVEL,
+    rounds: int = BOOTSTRAP_ROUNDS,
+    seed: int = 0,
+) -> tuple[dict[str, Intervals], tuple[float, float] | None]:
+    """Bootstrap intervals of each channel's held-out NRMSE (before, after) and the closure.
+
+    The closure is the share of the gap above the noise that the named effects close,
+    (X_before − X_after) / (X_before − 1) with X the held-out excess (``heldout_excess``).
+    """
+    rng = np.random.default_rng(seed)
+    per_trace = [_block_sums(tr, b, a) for tr, b, a in zip(traces, before, after, strict=True)]
+    if not per_trace or any(s[0].n.size == 0 for s in per_trace):
+        return {}, None
+    # Resample each trace's held-out blocks: weights (rounds, blocks) of draw counts.
+    weights = [
+        np.stack([np.bincount(row, minlength=s[0].n.size) for row in rng.integers(
+            0, s[0].n.size, size=(rounds, s[0].n.size))]).astype(float)
+        for s in per_trace
+    ]  # fmt: skip
+    totals: dict[str, dict[str, list[FloatArray]]] = {}
+    logs_before: list[FloatArray] = []
+    logs_after: list[FloatArray] = []
+    for sums, w in zip(per_trace, weights, strict=True):
+        for name, s in zip(("u", "F"), sums, strict=True):
+            n, r, r2 = w @ s.n, w @ s.rec, w @ s.rec2
+            eb, ea = w @ s.err_before, w @ s.err_after
+            parts = totals.setdefault(name, {k: [] for k in ("n", "r", "r2", "eb", "ea")})
+            for key, v in (("n", n), ("r", r), ("r2", r2), ("eb", eb), ("ea", ea)):
+                parts[key].append(v)
+            n_safe = np.maximum(n, 1.0)
+            logs_before.append(np.log(np.maximum(np.sqrt(eb / n_safe) / s.scale, 1e-300)))
+            logs_after.append(np.log(np.maximum(np.sqrt(ea / n_safe) / s.scale, 1e-300)))
+    tail = 50 * (1 - level)
+    pct = (tail, 100 - tail)
+    channel: dict[str, Intervals] = {"before": {}, "after": {}}
+    for name, parts in totals.items():
+        n, r, r2 = (np.sum(parts[k], axis=0) for k in ("n", "r", "r2"))
+        spread = np.sqrt(np.maximum(r2 - r**2 / np.maximum(n, 1.0), 1e-300))
+        for when, key in (("before", "eb"), ("after", "ea")):
+            nrmse = np.sqrt(np.sum(parts[key], axis=0)) / spread
+            lo, hi = np.percentile(nrmse, pct)
+            channel[when][name] = (float(lo), float(hi))
+    x_before = np.exp(np.mean(logs_before, axis=0))
+    x_after = np.exp(np.mean(logs_after, axis=0))
+    closure = np.maximum(-1.0, (x_before - x_after) / np.maximum(x_before - 1.0, 1e-12))
+    lo, hi = np.percentile(closure, pct)
+    return channel, (float(lo), float(hi))
