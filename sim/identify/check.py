@@ -114,6 +114,10 @@ class Case:
     verdict: str = ""
     named: tuple[str, ...] = ()
     signature_kinds: tuple[str, ...] = ()
+    #: Per true parameter the diagnosis gave an interval for: whether it holds the truth.
+    covered: dict[str, bool] = field(default_factory=dict)
+    #: Per baseline parameter fitted per recording that moved: what it moved with.
+    trends: dict[str, str] = field(default_factory=dict)
 
     @property
     def right(self) -> bool:
@@ -157,6 +161,8 @@ class CheckResult:
             ),
             "median_seconds": float(np.median([c.seconds for c in self.cases])) if n else 0.0,
             "verdicts": verdict_summary(self.cases),
+            "coverage": coverage_summary(self.cases),
+            "trends": trend_summary(self.cases),
             "details": [c.__dict__ for c in self.cases],
             **({"pairs": pairs_summary(self.pair_cases)} if self.pair_cases else {}),
         }
@@ -189,6 +195,50 @@ def verdict_summary(cases: Sequence[Case]) -> dict[str, Any]:
         ),
         "catalogue_exact": share(catalogue, lambda c: c.named == (c.truth,)),
     }
+
+
+def coverage_summary(cases: Sequence[Case]) -> dict[str, dict[str, float]]:
+    """Per parameter (the baseline's and ``effect.param``): share of intervals holding the truth.
+
+    Counted where the truth is known and the diagnosis reported an interval for it: the
+    baseline's multipliers on same-form truths, an effect's parameters where the effect
+    was named. ``{name: {"share": s, "intervals": n}}``, and ``all`` over every parameter.
+    """
+    counts: dict[str, list[bool]] = {}
+    for c in cases:
+        for name, held in c.covered.items():
+            counts.setdefault(name, []).append(held)
+    out = {n: {"share": sum(v) / len(v), "intervals": len(v)} for n, v in sorted(counts.items())}
+    every = [h for v in counts.values() for h in v]
+    if every:
+        out["all"] = {"share": sum(every) / len(every), "intervals": len(every)}
+    return out
+
+
+def trend_summary(cases: Sequence[Case]) -> dict[str, dict[str, float]]:
+    """Per truth: the share of campaigns whose baseline stiffness was flagged moving with rate."""
+    by_truth: dict[str, list[bool]] = {}
+    for c in cases:
+        flagged = c.trends.get("stiffness_scale") == "drive_rate_hz"
+        by_truth.setdefault(c.truth, []).append(flagged)
+    return {
+        t: {"stiffness_with_rate": sum(v) / len(v), "campaigns": len(v)}
+        for t, v in by_truth.items()
+    }
+
+
+def covered_truth(d: Diagnosis, truth: dict[str, float]) -> dict[str, bool]:
+    """Whether each interval the diagnosis gives holds the true value (where it is known)."""
+    held = {}
+    for name, (lo, hi) in d.baseline_intervals.items():
+        if name in truth:
+            held[name] = bool(lo <= truth[name] <= hi)
+    for a in d.effects:
+        for name, (lo, hi) in a.intervals.items():
+            key = f"{a.effect}.{name}"
+            if key in truth and lo < hi:  # a held count or threshold has no interval
+                held[key] = bool(lo <= truth[key] <= hi)
+    return held
 
 
 def make_campaign(
@@ -360,9 +410,11 @@ def diagnose_case(
         # no evidence of an effect, ``none`` is what the recordings show.
         identifiable = compare(traces, d.outputs_before, oracle).accepted(tests=1)
     kinds = tuple(s.kind for s in d.remainder.signature if s.passes) if d.remainder else ()
+    trends = {k: v["moves_with"] for k, v in d.baseline_consistency.items() if v["moves_with"]}
     case = Case(
         spec.truth, spec.mass_kg, d.effect, params, shrink, oracle_shrink, seconds, identifiable,
         d.verdict, named_effects(d), kinds,
+        covered_truth(d, params) if truth_stand == "same" else {}, trends,
     )  # fmt: skip
     return case, d
 

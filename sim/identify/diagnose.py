@@ -32,6 +32,7 @@ import logging
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -56,6 +57,8 @@ from sim.identify.heldout import (
     heldout_excess,
     noise_floor,
 )
+from sim.identify.intervals import GAP_METHOD, PARAMETER_METHOD, gap_intervals, parameter_intervals
+from sim.identify.per_recording import per_recording_report
 from sim.identify.remainder import judge_signatures, remainder_of, verdict
 from sim.identify.report import AcceptedEffect, Diagnosis, RankedEffect
 from sim.identify.screening import outputs_of, screen
@@ -357,6 +360,12 @@ def diagnose(
         after_out = current.outputs
         after_values = current.result.values
     x_after = heldout_excess(traces, after_out)
+    say("how sure: intervals, and the parameters per recording")
+    started = time.perf_counter()
+    final = current.result if accepted else FitResult(base_fit.candidate, base_values, 0.0, 0)
+    sure, sure_sims = how_sure(final, base_values, accepted, traces, nominal, base_out, after_out)
+    sims += sure_sims
+    timings["intervals"] = time.perf_counter() - started
 
     # The fitted baseline as the fit saw it (segments from measured states): an
     # open-loop run of a chaotic light-weight recording would attribute chaos.
@@ -382,7 +391,7 @@ def diagnose(
         where=where_the_gap_lies(traces, states),
         gap_before=channel_gap(traces, base_out),
         gap_after=channel_gap(traces, after_out),
-        baseline=base_values,
+        baseline={k: final.values[k] for k in base_values},
         heldout_error_before=heldout_error(traces, base_out),
         heldout_error_after=heldout_error(traces, after_out),
         noise_floor=noise_floor(traces),
@@ -395,7 +404,48 @@ def diagnose(
         verdict=verdict(bool(accepted), remainder),
         remainder=remainder,
         displaced=displaced,
+        **sure,
     )
+
+
+def how_sure(
+    final: FitResult,
+    base_values: dict[str, float],
+    accepted: Sequence[AcceptedEffect],
+    traces: Sequence[Trace],
+    nominal: StandParams,
+    before: Sequence[Outputs],
+    after: Sequence[Outputs],
+) -> tuple[dict[str, Any], int]:
+    """Intervals of the final model's parameters and of the gap, and the per-recording fits.
+
+    The named effects' parameters are reported as the final model (all of them together)
+    has them. Returns the Diagnosis fields and the simulations spent.
+    """
+    sure = parameter_intervals(final.candidate, final.values, traces, nominal)
+    for a in accepted:
+        prefix = f"{a.effect}."
+        a.params = _effect_params(a.effect, final.values)
+        a.intervals = {
+            k[len(prefix) :]: v for k, v in sure.intervals.items() if k.startswith(prefix)
+        }
+        a.at_bound = _at_bound(final, a.effect)
+        a.reaches_bound = [k[len(prefix) :] for k in sure.reaches_bound if k.startswith(prefix)]
+    gaps, closure = gap_intervals(traces, before, after)
+    table, agree, alone, sims = per_recording_report(
+        final.candidate, final.values, base_values, traces, nominal
+    )
+    fields = {
+        "baseline_intervals": {k: v for k, v in sure.intervals.items() if k in base_values},
+        "baseline_reaches_bound": [k for k in sure.reaches_bound if k in base_values],
+        "gap_closure_interval": closure,
+        "gap_intervals": gaps,
+        "interval_method": f"{PARAMETER_METHOD}; {GAP_METHOD}",
+        "per_recording": table,
+        "consistency": agree,
+        "baseline_consistency": alone,
+    }
+    return fields, sure.simulations + sims
 
 
 def signature_rival(

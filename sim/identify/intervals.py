@@ -53,6 +53,9 @@ class ParameterIntervals:
     reaches_bound: list[str] = field(default_factory=list)
     #: Standard errors in the optimiser's coordinates (what a consistency test compares).
     internal_se: dict[str, float] = field(default_factory=dict)
+    #: How much wider than a normal interval these are (Student t's quantile over the
+    #: normal's): what a test of the standard errors widens them by too.
+    widening: float = 1.0
     simulations: int = 0
 
 
@@ -114,6 +117,7 @@ def parameter_intervals(
     out.simulations = objective.simulations
     cov, clusters = sandwich_covariance(jac, residuals, _block_labels(traces, stride))
     t = float(stats.t.ppf(0.5 + level / 2, max(clusters - 1, 1)))
+    out.widening = t / float(stats.norm.ppf(0.5 + level / 2))
     free_params = [p for p, f in zip(candidate.params, free, strict=True) if f]
     for k, p in enumerate(free_params):
         se = math.sqrt(max(float(cov[k, k]), 0.0))

@@ -74,6 +74,9 @@ class AcceptedEffect:
     indistinguishable_from: list[str] = field(default_factory=list)
     #: 95 % intervals of ``params`` (the method: ``Diagnosis.interval_method``).
     intervals: Intervals = field(default_factory=dict)
+    #: Parameters whose interval reaches their physical bound: the recordings cannot say
+    #: how far beyond it they would go.
+    reaches_bound: list[str] = field(default_factory=list)
 
     def to_dict(self) -> dict[str, object]:
         """JSON keys effect, closure, p_value, params, intervals, at_bound, ..."""
@@ -83,6 +86,7 @@ class AcceptedEffect:
             "p_value": self.p_value,
             "params": self.params,
             "intervals": _listed(self.intervals),
+            "reaches_bound": self.reaches_bound,
             "at_bound": self.at_bound,
             "indistinguishable_from": self.indistinguishable_from,
         }
@@ -117,6 +121,7 @@ class Diagnosis:
     displaced: dict[str, str] = field(default_factory=dict)
     #: 95 % intervals of ``baseline`` (stiffness_scale, damping_scale, friction_scale).
     baseline_intervals: Intervals = field(default_factory=dict)
+    baseline_reaches_bound: list[str] = field(default_factory=list)
     gap_closure_interval: tuple[float, float] | None = None
     #: Per channel, the held-out NRMSE's 95 % interval before and after the named effects:
     #: ``{"before": {"u": (lo, hi), "F": ...}, "after": {...}}``.
@@ -128,6 +133,9 @@ class Diagnosis:
     per_recording: dict[str, dict[str, Any]] = field(default_factory=dict)
     #: Do the per-recording fits agree: ``{parameter: {"p_value": p, "trend": words|None}}``.
     consistency: dict[str, dict[str, Any]] = field(default_factory=dict)
+    #: The same for the baseline alone fitted per recording (where effects are named;
+    #: else the same as ``consistency``): what the named effects took out of the trends.
+    baseline_consistency: dict[str, dict[str, Any]] = field(default_factory=dict)
 
     @property
     def effect(self) -> str:
@@ -156,6 +164,7 @@ class Diagnosis:
             "simulations": self.simulations,
             "timings_s": self.timings_s,
             "baseline_intervals": _listed(self.baseline_intervals),
+            "baseline_reaches_bound": self.baseline_reaches_bound,
             "gap_closure_interval": (
                 list(self.gap_closure_interval) if self.gap_closure_interval else None
             ),
@@ -163,6 +172,7 @@ class Diagnosis:
             "interval_method": self.interval_method,
             "per_recording": self.per_recording,
             "consistency": self.consistency,
+            "baseline_consistency": self.baseline_consistency,
         }
 
 
