@@ -1,0 +1,165 @@
+"""How sure: intervals of the fitted parameters and the gap, and the per-recording fits."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy import stats
+
+from sim.config import StandConfig
+from sim.identify import diagnose, make_trace
+from sim.identify.check import CaseSpec, covered_truth, make_campaign, recording_set
+from sim.identify.fitting import Candidate
+from sim.identify.heldout import Outputs, channel_gap
+from sim.identify.intervals import (
+    ParameterIntervals,
+    gap_intervals,
+    parameter_intervals,
+    sandwich_covariance,
+)
+from sim.identify.per_recording import RecordingFit, consistency, drive_of
+
+HEAVY = 8.131
+
+
+def test_the_sandwich_covers_a_slope_under_errors_correlated_within_blocks() -> None:
+    # y = a + b·t with errors that share a random level within each block (what a slack
+    # event or a misfit stretch does to a fit's residuals): the least-squares slope's
+    # naive standard error is too small, the cluster-robust one is not.
+    rng = np.random.default_rng(1)
+    blocks, per_block, truth = 24, 40, np.array([0.5, 2.0])
+    t = np.linspace(0.0, 1.0, blocks * per_block)
+    jac = np.column_stack([np.ones_like(t), t])
+    labels = np.repeat(np.arange(blocks), per_block)
+    q = float(stats.t.ppf(0.975, blocks - 1))
+    naive_hits, robust_hits, trials = 0, 0, 400
+    for _ in range(trials):
+        noise = rng.normal(0, 1.0, blocks)[labels] + rng.normal(0, 0.3, t.size)
+        y = jac @ truth + noise
+        coef, *_ = np.linalg.lstsq(jac, y, rcond=None)
+        residuals = jac @ coef - y
+        cov, g = sandwich_covariance(jac, residuals, labels)
+        assert g == blocks
+        naive = np.linalg.inv(jac.T @ jac) * residuals.var()
+        naive_hits += abs(coef[1] - truth[1]) <= 1.96 * math.sqrt(naive[1, 1])
+        robust_hits += abs(coef[1] - truth[1]) <= q * math.sqrt(cov[1, 1])
+    assert robust_hits / trials >= 0.9
+    assert naive_hits / trials < 0.6  # the correlation is real: ignoring it misleads
+
+
+def test_baseline_intervals_hold_the_drawn_stand_and_widen_with_the_noise(
+    stand: StandConfig,
+) -> None:
+    recordings = recording_set("moderate", stand)[2:]
+    spec = CaseSpec("none", HEAVY, 0, 3)
+    traces, _, truth = make_campaign(stand, "none", HEAVY, spec.rng(), recordings)
+    nominal = stand.stand_params("final", HEAVY)
+    quiet = parameter_intervals(Candidate.build(), truth, traces, nominal)
+    for name in ("stiffness_scale", "damping_scale", "friction_scale"):
+        lo, hi = quiet.intervals[name]
+        assert lo <= truth[name] <= hi, name
+    # The same campaign with ten times the force noise: every interval is wider.
+    rng = np.random.default_rng(0)
+    noisy = []
+    for tr in traces:
+        extra = rng.normal(0.0, 10 * tr.noise_force_n, tr.samples)
+        t = np.arange(tr.samples) / tr.rate_hz
+        noisy.append(make_trace(tr.name, t, tr.x_m, tr.u_m, tr.force_n + extra, tr.mass_kg))
+    loud = parameter_intervals(Candidate.build(), truth, noisy, nominal)
+    for name, (lo, hi) in quiet.intervals.items():
+        low, high = loud.intervals[name]
+        assert high - low > hi - lo, name
+
+
+def _outputs(rng: np.random.Generator, rec: np.ndarray, error: float) -> np.ndarray:
+    return rec + rng.normal(0.0, error, rec.size)
+
+
+def test_gap_intervals_hold_the_point_figures_and_narrow_with_more_cycles(
+    stand: StandConfig,
+) -> None:
+    recordings = recording_set("moderate", stand)
+    spec = CaseSpec("none", HEAVY, 0, 4)
+    traces, _, _ = make_campaign(stand, "none", HEAVY, spec.rng(), recordings)
+    rng = np.random.default_rng(2)
+    before = [
+        Outputs(_outputs(rng, t.u_m, 5 * t.noise_u_m), _outputs(rng, t.force_n, 5 * t.noise_force_n))
+        for t in traces
+    ]
+    after = [
+        Outputs(_outputs(rng, t.u_m, t.noise_u_m), _outputs(rng, t.force_n, t.noise_force_n))
+        for t in traces
+    ]
+    gaps, closure = gap_intervals(traces, before, after)
+    point_before, point_after = channel_gap(traces, before), channel_gap(traces, after)
+    for ch in ("u", "F"):
+        lo, hi = gaps["before"][ch]
+        assert lo <= point_before[ch]["nrmse"] <= hi
+        lo, hi = gaps["after"][ch]
+        assert lo <= point_after[ch]["nrmse"] <= hi
+    # Errors of five noise units cut to one (plus the noise itself): about all the gap
+    # above the noise is closed (a little more where the noise read low), and the
+    # interval says so.
+    assert closure is not None
+    assert closure[0] > 0.8 and closure[1] < 1.1
+    _, fewer = gap_intervals(traces[:1], before[:1], after[:1])
+    assert fewer is not None
+    assert fewer[1] - fewer[0] > closure[1] - closure[0]
+
+
+def _fit(name: str, rate: float, stiffness: float, se: float) -> RecordingFit:
+    sure = ParameterIntervals(internal_se={"stiffness_scale": se, "damping_scale": se})
+    values = {"stiffness_scale": stiffness, "damping_scale": 1.0, "friction_scale": 1.0}
+    drive = {"drive_rate_hz": rate, "stroke_m": 0.03, "mass_kg": HEAVY}
+    return RecordingFit(name, values, sure, drive)
+
+
+def test_consistency_flags_a_stiffness_that_rises_with_the_drive_rate() -> None:
+    base = Candidate.build()
+    rising = [_fit(f"r{k}", r, math.exp(0.05 * r), 0.01) for k, r in enumerate((0.4, 1, 2, 3))]
+    verdict = consistency(base, rising)["stiffness_scale"]
+    assert verdict["p_value"] < 0.01
+    assert verdict["moves_with"] == "drive_rate_hz"
+    assert "relaxation branch" in verdict["points_to"]
+    # The same spread with intervals ten times wider: the recordings agree.
+    vague = [_fit(f.name, f.drive["drive_rate_hz"], f.values["stiffness_scale"], 0.1)
+             for f in rising]  # fmt: skip
+    assert consistency(base, vague)["stiffness_scale"]["moves_with"] is None
+    assert consistency(base, vague)["damping_scale"]["p_value"] == pytest.approx(1.0)
+
+
+def test_the_drive_rate_of_a_sine_is_its_frequency(stand: StandConfig) -> None:
+    rate = 2000.0
+    t = np.arange(int(6 * rate)) / rate
+    x = 0.02 * np.sin(2 * np.pi * 1.5 * t)
+    trace = make_trace("sine", t, x, 1e-3 * x, 50 + 100 * x, HEAVY)
+    assert drive_of(trace)["drive_rate_hz"] == pytest.approx(1.5, rel=0.02)
+
+
+def test_a_diagnosis_reports_intervals_that_hold_its_numbers(stand: StandConfig) -> None:
+    recordings = recording_set("moderate", stand)[2:]
+    spec = CaseSpec("fibre_viscoelastic", HEAVY, 0, 2)
+    traces, _, truth = make_campaign(stand, spec.truth, HEAVY, spec.rng(), recordings)
+    nominal = stand.stand_params("final", HEAVY)
+    d = diagnose(traces, nominal, candidates=["fibre_viscoelastic", "channel_time_skew"])
+    assert [a.effect for a in d.effects] == ["fibre_viscoelastic"]
+    assert set(d.baseline_intervals) == {"stiffness_scale", "damping_scale", "friction_scale"}
+    for name, value in d.baseline.items():
+        lo, hi = d.baseline_intervals[name]
+        assert lo <= value <= hi
+    (effect,) = d.effects
+    assert set(effect.intervals) == set(effect.params)
+    assert d.gap_closure_interval is not None
+    lo, hi = d.gap_closure_interval
+    assert lo <= d.gap_closure <= hi
+    # Every recording fitted alone, with its drive, and a consistency entry per parameter.
+    assert set(d.per_recording) == {t.name for t in traces}
+    assert set(d.consistency) >= {"stiffness_scale", "fibre_viscoelastic.relaxation_time_s"}
+    held = covered_truth(d, truth)
+    assert set(held) >= {"stiffness_scale", "fibre_viscoelastic.relaxation_time_s"}
+    payload = d.to_dict()
+    assert payload["effects"][0]["intervals"]["relaxation_time_s"] == list(
+        effect.intervals["relaxation_time_s"]
+    )
