@@ -20,6 +20,7 @@ from sim.identify.intervals import (
     sandwich_covariance,
 )
 from sim.identify.per_recording import RecordingFit, consistency, drive_of
+from sim.identify.traces import Trace
 
 HEAVY = 8.131
 
@@ -73,8 +74,11 @@ def test_baseline_intervals_hold_the_drawn_stand_and_widen_with_the_noise(
         assert high - low > hi - lo, name
 
 
-def _outputs(rng: np.random.Generator, rec: np.ndarray, error: float) -> np.ndarray:
-    return rec + rng.normal(0.0, error, rec.size)
+def _model(rng: np.random.Generator, trace: Trace, noise_units: float) -> Outputs:
+    """Outputs off the recording by ``noise_units`` of each channel's noise."""
+    u = trace.u_m + rng.normal(0.0, noise_units * trace.noise_u_m, trace.samples)
+    f = trace.force_n + rng.normal(0.0, noise_units * trace.noise_force_n, trace.samples)
+    return Outputs(u, f)
 
 
 def test_gap_intervals_hold_the_point_figures_and_narrow_with_more_cycles(
@@ -84,14 +88,8 @@ def test_gap_intervals_hold_the_point_figures_and_narrow_with_more_cycles(
     spec = CaseSpec("none", HEAVY, 0, 4)
     traces, _, _ = make_campaign(stand, "none", HEAVY, spec.rng(), recordings)
     rng = np.random.default_rng(2)
-    before = [
-        Outputs(_outputs(rng, t.u_m, 5 * t.noise_u_m), _outputs(rng, t.force_n, 5 * t.noise_force_n))
-        for t in traces
-    ]
-    after = [
-        Outputs(_outputs(rng, t.u_m, t.noise_u_m), _outputs(rng, t.force_n, t.noise_force_n))
-        for t in traces
-    ]
+    before = [_model(rng, t, 5.0) for t in traces]
+    after = [_model(rng, t, 1.0) for t in traces]
     gaps, closure = gap_intervals(traces, before, after)
     point_before, point_after = channel_gap(traces, before), channel_gap(traces, after)
     for ch in ("u", "F"):
