@@ -116,7 +116,8 @@ class Case:
     signature_kinds: tuple[str, ...] = ()
     #: Per true parameter the diagnosis gave an interval for: whether it holds the truth.
     covered: dict[str, bool] = field(default_factory=dict)
-    #: Per baseline parameter fitted per recording that moved: what it moved with.
+    #: Per baseline parameter fitted per recording that moved: what it moved with
+    #: (covariates joined by ``+`` where the recordings cannot tell them apart).
     trends: dict[str, str] = field(default_factory=dict)
 
     @property
@@ -219,7 +220,7 @@ def trend_summary(cases: Sequence[Case]) -> dict[str, dict[str, float]]:
     """Per truth: the share of campaigns whose baseline stiffness was flagged moving with rate."""
     by_truth: dict[str, list[bool]] = {}
     for c in cases:
-        flagged = c.trends.get("stiffness_scale") == "drive_rate_hz"
+        flagged = "drive_rate_hz" in c.trends.get("stiffness_scale", "").split("+")
         by_truth.setdefault(c.truth, []).append(flagged)
     return {
         t: {"stiffness_with_rate": sum(v) / len(v), "campaigns": len(v)}
@@ -410,7 +411,11 @@ def diagnose_case(
         # no evidence of an effect, ``none`` is what the recordings show.
         identifiable = compare(traces, d.outputs_before, oracle).accepted(tests=1)
     kinds = tuple(s.kind for s in d.remainder.signature if s.passes) if d.remainder else ()
-    trends = {k: v["moves_with"] for k, v in d.baseline_consistency.items() if v["moves_with"]}
+    trends = {
+        k: "+".join([v["moves_with"], *v.get("also_with", [])])
+        for k, v in d.baseline_consistency.items()
+        if v["moves_with"]
+    }
     case = Case(
         spec.truth, spec.mass_kg, d.effect, params, shrink, oracle_shrink, seconds, identifiable,
         d.verdict, named_effects(d), kinds,

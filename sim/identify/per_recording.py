@@ -138,32 +138,44 @@ def consistency(candidate: Candidate, fits: Sequence[RecordingFit]) -> dict[str,
 def _trend(
     name: str, theta: np.ndarray, w: np.ndarray, fits: Sequence[RecordingFit]
 ) -> dict[str, Any]:
-    """The covariate the parameter follows best (weighted regression), if any does."""
-    best: tuple[float, str, float] | None = None
+    """What the parameter follows (weighted regression on each covariate alone).
+
+    A few recordings often differ in several things at once (the paper's quick tests are
+    short strokes, its slow ones long): every covariate that explains the spread is
+    named, best first, and so is what each points to — the recordings cannot say which.
+    """
+    found: list[tuple[float, str, float]] = []
     tried = 0
     for key, _, _ in COVARIATES:
         x = np.array([f.drive[key] for f in fits])
-        sxx = float(np.sum(w * (x - np.sum(w * x) / np.sum(w)) ** 2))
+        xm = float(np.sum(w * x) / np.sum(w))
+        sxx = float(np.sum(w * (x - xm) ** 2))
         if not sxx > 1e-12 * float(np.sum(w * x**2) + 1e-300):
             continue  # the recordings do not differ in it
         tried += 1
-        xm = float(np.sum(w * x) / np.sum(w))
         slope = float(np.sum(w * (x - xm) * theta) / sxx)
-        z = slope * math.sqrt(sxx)
-        p = float(2 * stats.norm.sf(abs(z)))
-        if best is None or p < best[0]:
-            best = (p, key, slope)
-    if best is None or best[0] * max(tried, 1) >= CONSISTENCY_ALPHA:
+        found.append((float(2 * stats.norm.sf(abs(slope) * math.sqrt(sxx))), key, slope))
+    found = sorted(f for f in found if f[0] * tried < CONSISTENCY_ALPHA)
+    if not found:
         return {"trend": "differs between recordings, following none of rate, stroke or mass"}
-    p, key, slope = best
-    words, unit = next((w_, u) for k, w_, u in COVARIATES if k == key)
-    sign = 1 if slope > 0 else -1
+    words = {k: w_ for k, w_, _ in COVARIATES}
+    units = {k: u for k, _, u in COVARIATES}
+    parts = [
+        f"{'rises' if slope > 0 else 'falls'} with {words[key]} (p {p * tried:.2g})"
+        for p, key, slope in found
+    ]
+    trend = f"{name} " + " and ".join(parts)
+    if len(found) > 1:
+        trend += ": these recordings do not tell them apart"
+    pointers = [POINTS_TO.get((name, key, 1 if slope > 0 else -1)) for _, key, slope in found]
+    _, key, slope = found[0]
     return {
-        "trend": f"{name} {'rises' if sign > 0 else 'falls'} with {words} (p {p * tried:.2g})",
+        "trend": trend,
         "moves_with": key,
+        "also_with": [k for _, k, _ in found[1:]],
         "slope_per_unit": slope,
-        "unit": unit,
-        "points_to": POINTS_TO.get((name, key, sign)),
+        "unit": units[key],
+        "points_to": "; or ".join(p for p in pointers if p) or None,
     }
 
 
