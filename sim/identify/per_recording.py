@@ -48,7 +48,10 @@ POINTS_TO = {
         "damping that falls with frequency, as a relaxation branch's does (fibre_viscoelastic)"
     ),
     ("stiffness_scale", "stroke_m", 1): "a fibre that stiffens with strain (a nonlinear law)",
-    ("stiffness_scale", "stroke_m", -1): "a fibre that softens with strain, or a slipping clamp",
+    ("stiffness_scale", "stroke_m", -1): (
+        "a relaxation branch that relaxes through a long stroke (fibre_viscoelastic), "
+        "a fibre that softens with strain, or a slipping clamp"
+    ),
     ("friction_scale", "drive_rate_hz", 1): "friction that grows with speed (a drag term)",
     ("friction_scale", "drive_rate_hz", -1): "friction that falls with speed (stick-slip)",
     ("friction_scale", "mass_kg", 1): "friction that grows with load (side-load friction)",
