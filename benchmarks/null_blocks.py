@@ -28,8 +28,8 @@ from sim.identify.heldout import Outputs
 from sim.identify.traces import Trace
 
 BLOCKS_S = (0.25, 0.125)
-#: The module itself (``sim.identify.diagnose`` names the function): its judge is wrapped.
-_diagnose: Any = importlib.import_module("sim.identify.diagnose")
+#: The diagnosis's pipeline, whose judge (of the first stage's refits) is wrapped.
+_diagnose: Any = importlib.import_module("sim.identify.pipeline")
 
 
 def _judge_at(

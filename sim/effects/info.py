@@ -104,7 +104,7 @@ class ParamInfo:
     integer: bool = False
     #: Says how the effect acts rather than how large it is (a friction model's presliding
     #: stiffness): held at ``default`` in every candidate's refit, fitted only for the
-    #: candidate that fits the training cycles best (``sim.identify.diagnose.refine_form``).
+    #: candidate that fits the training cycles best (``sim.identify.refitting.refine_form``).
     form: bool = False
 
     @property

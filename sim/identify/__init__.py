@@ -9,7 +9,7 @@ Exceptions::
      └── DiagnosisInputError   recordings that cannot be diagnosed (says what is missing)
 """
 
-from sim.identify.diagnose import diagnose
+from sim.identify.pipeline import diagnose
 from sim.identify.report import Diagnosis
 from sim.identify.traces import DiagnosisInputError, Trace, make_trace
 

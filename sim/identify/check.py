@@ -35,9 +35,9 @@ from sim.effects import EFFECTS, EffectSpec
 from sim.effects.realism import MeasurementNoise, NoiseSpec, draw_real_stand
 from sim.identify.check_other import PairCase, named_effects, other_campaign_traces, pairs_summary
 from sim.identify.decide import compare
-from sim.identify.diagnose import diagnose
 from sim.identify.fitting import Candidate, simulate_values
 from sim.identify.heldout import Outputs, heldout_error
+from sim.identify.pipeline import diagnose
 from sim.identify.report import Diagnosis
 from sim.identify.shooting import dial_slope
 from sim.identify.traces import Trace, make_trace

@@ -14,8 +14,8 @@ from sim.effects.realism import MeasurementNoise, NoiseSpec, draw_real_stand
 from sim.identify import diagnose, make_trace
 from sim.identify.check import DRIVE_NOISE_M, SMALL_CAMPAIGN
 from sim.identify.decide import Evidence, family_p_values, p_value_of_gains
-from sim.identify.diagnose import SECOND_STAGE, beats, second_tries, strongest_accepted
 from sim.identify.fitting import FreeParam
+from sim.identify.naming import SECOND_STAGE, beats, second_tries, strongest_accepted
 from sim.identify.report import Diagnosis, RankedEffect
 from sim.identify.traces import Trace
 from sim.model import Model
@@ -101,18 +101,17 @@ def test_a_second_effect_starts_where_its_refit_alone_ended(
     # gauge low-pass ended in another basin after a 0.1 % change of its objective. Its
     # own refit alone has shown a basin on the training cycles, so every second-stage
     # start grid holds where that refit ended.
-    import importlib
+    from sim.identify import naming
 
-    module = importlib.import_module("sim.identify.diagnose")
     starts: dict[str, list[dict[str, float]]] = {}
-    refit = module._refit
+    refit = naming.refit
 
     def spy(candidate, traces, nominal, start_from, extra=()):  # type: ignore[no-untyped-def]
         if len(candidate.effects) == 2:
             starts[candidate.effects[1]] = list(extra)
         return refit(candidate, traces, nominal, start_from, extra)
 
-    monkeypatch.setattr(module, "_refit", spy)
+    monkeypatch.setattr(naming, "refit", spy)
     result = _gauge_and_pulley(stand)
     alone = {r.effect: r.params for r in result.ranking}
     assert "pulley_inertia_friction" in starts

@@ -9,8 +9,8 @@ import pytest
 
 from sim.config import default_config
 from sim.identify.check import CaseSpec, make_campaign
-from sim.identify.diagnose import REFIT_FTOL
 from sim.identify.fitting import Candidate, Objective, effect_grid_start, fit
+from sim.identify.refitting import REFIT_FTOL
 from sim.identify.shooting import dial_slope
 from sim.identify.traces import Trace
 from sim.params import StandParams

@@ -9,8 +9,8 @@ import pytest
 
 from sim.config import default_config
 from sim.identify.check import SMALL_CAMPAIGN, CaseSpec, make_campaign
-from sim.identify.diagnose import _refit, refine_form
 from sim.identify.fitting import Candidate, fit, grid_axis
+from sim.identify.refitting import refine_form, refit
 from sim.identify.shooting import dial_slope
 from sim.identify.traces import Trace
 from sim.params import StandParams
@@ -54,7 +54,7 @@ def test_a_stand_that_sticks_without_presliding_fits_a_stiff_bristle() -> None:
     # with σ₀ fitted the training cost and the held-out excess fall, σ₀ well above 1e5.
     traces, nominal = _campaign("other", 2)
     base = fit(Candidate.build(), traces, nominal)
-    held = _refit(Candidate.build(EFFECT), traces, nominal, base.values)
+    held = refit(Candidate.build(EFFECT), traces, nominal, base.values)
     assert held.result.values[SIGMA] == pytest.approx(1.0e5)
     refined, sims = refine_form(held, traces, nominal, lambda _msg: None)
     assert sims > 0
@@ -67,7 +67,7 @@ def test_a_lugre_stand_keeps_its_presliding_stiffness_when_its_form_is_fitted() 
     # The candidate's own form at its default σ₀ (1e5 N/m): freeing σ₀ finds it again.
     traces, nominal = _campaign("same", 1)
     base = fit(Candidate.build(), traces, nominal)
-    held = _refit(Candidate.build(EFFECT), traces, nominal, base.values)
+    held = refit(Candidate.build(EFFECT), traces, nominal, base.values)
     refined, sims = refine_form(held, traces, nominal, lambda _msg: None)
     assert sims > 0  # it was fitted, and stayed near the truth
     assert 0.5e5 < refined.result.values[SIGMA] < 2.0e5
@@ -77,6 +77,6 @@ def test_a_lugre_stand_keeps_its_presliding_stiffness_when_its_form_is_fitted() 
 def test_a_candidate_without_form_parameters_is_not_refitted() -> None:
     traces, nominal = _campaign("same", 1)
     base = fit(Candidate.build(), traces, nominal)
-    fitted = _refit(Candidate.build("side_load_friction"), traces, nominal, base.values)
+    fitted = refit(Candidate.build("side_load_friction"), traces, nominal, base.values)
     again, sims = refine_form(fitted, traces, nominal, lambda _msg: None)
     assert sims == 0 and again is fitted

@@ -78,8 +78,8 @@ def test_seat_steps_are_read_again_with_the_refits_own_baseline(stand: StandConf
     # that basin (step −2.3 mm) with k and c near the truth. Read again there, the
     # steps give the ratchet: a far better fit, the truth's step and seats.
     from sim.identify.check import CaseSpec, make_campaign
-    from sim.identify.diagnose import _short_fit, read_again
     from sim.identify.fitting import Candidate, effect_grid_start, fit
+    from sim.identify.refitting import read_again, short_fit
     from sim.identify.shooting import dial_slope
     from sim.otherstand.campaign import OTHER_SETS
 
@@ -96,7 +96,7 @@ def test_seat_steps_are_read_again_with_the_refits_own_baseline(stand: StandConf
     probes = seat_probes(traces, nominal, base.values)
     read_at_fit = [p for p in probes if "stiffness_scale" not in p]  # not the taut law's
     start = effect_grid_start(candidate, traces, nominal, base.values, read_at_fit)
-    first = _short_fit(candidate, traces, nominal, start)
+    first = short_fit(candidate, traces, nominal, start)
     again = read_again(candidate, traces, nominal, first)
     assert again.train_cost < 0.5 * first.train_cost
     step = truth[f"{EFFECT}.step_m"]
@@ -107,7 +107,7 @@ def test_seat_steps_are_read_again_with_the_refits_own_baseline(stand: StandConf
     # The starts read with the taut intervals' own k and c (``taut_law``) reach the
     # ratchet from the first fit.
     both = effect_grid_start(candidate, traces, nominal, base.values, probes)
-    direct = _short_fit(candidate, traces, nominal, both)
+    direct = short_fit(candidate, traces, nominal, both)
     assert direct.train_cost < 0.5 * first.train_cost
     assert abs(direct.values[f"{EFFECT}.step_m"] - step) < 0.1 * abs(step)
 

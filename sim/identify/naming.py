@@ -1,0 +1,243 @@
+"""Naming effects: which passes, which are indistinguishable, which further ones stand.
+
+The first effect is the best held-out closure among the candidates whose evidence holds
+(``strongest_accepted``), unless a signature of the remainder beats it
+(``signature_rival``). Further effects are tried one at a time on top of those named
+(``further_effect``), each judged against the model before it and against the richer
+forms the named effects declare.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+from sim.effects import EFFECTS
+from sim.identify.decide import Evidence, compare, judge
+from sim.identify.fitting import Candidate
+from sim.identify.heldout import Outputs, heldout_error
+from sim.identify.refitting import (
+    Fitted,
+    Progress,
+    bound_params,
+    closure,
+    data_starts,
+    effect_params,
+    polish,
+    refit,
+)
+from sim.identify.remainder import judge_signatures
+from sim.identify.report import AcceptedEffect, RankedEffect
+from sim.identify.screening import screen
+from sim.identify.traces import Trace
+from sim.params import StandParams
+
+#: Candidates tried on top of an accepted effect: this many by the score test on top of it,
+#: and this many by their training cost alone (see ``_second_effect``). Three: with
+#: two (up to four refits instead of six), once the pulley jump's refits read the seat
+#: again (``read_again``), the 32 pair campaigns of ``diagnose-check --truth other
+#: --pairs`` seeds 1 and 2 named both effects in 23, with three in 25: a better first
+#: effect leaves a smaller part of the gap, and the second moves down a list (a light
+#: pulley behind a ratchet: third by its training cost alone; a heavy one behind a gauge
+#: low-pass: third on the score test). Three and two named 24.
+SECOND_STAGE = 3
+#: Effects named at most, one at a time (the first, then further ones on top).
+MAX_EFFECTS = 4
+#: A runner-up is "indistinguishable" from the chosen effect unless the chosen one beats
+#: it on held-out cycles at this one-sided p-value (and by a gain X resolves: ``beats``).
+DISTINCT_P = 0.05
+
+
+def signature_rival(
+    traces: Sequence[Trace],
+    before: Sequence[Outputs],
+    nominal: StandParams,
+    values: dict[str, float],
+    effect: Sequence[Outputs],
+    named: Sequence[str] = (),
+) -> str | None:
+    """The kind of library term an effect does not beat on held-out cycles, or None.
+
+    A catalogue effect that fits a gap of another kind closes part of it (a gauge's gain
+    soaks up a drifting force offset): the first effect is not named if a signature of
+    the remainder (``signature``) that is itself evidence beats it (``beats``). Where
+    neither beats the other the first effect stands: it has a handful of physical
+    parameters against the library's dozen free terms, which over two short recordings
+    fitted a Maxwell branch with a gauge's gain as well as the branch did (X 23.8 against
+    24.4) with a 100 N pulley eccentricity.
+
+    A further effect, on top of those ``named``, must itself beat the richer forms the
+    named effects declare (``EffectInfo.richer``), fitted to their model's remainder,
+    whether those pass or not: a further effect that does no better only soaks up the
+    named ones' form mismatch (the other stand's dial gauge, with curvature and
+    backlash, had its backlash named as a time skew).
+    """
+    signatures, fits, _ = judge_signatures(traces, before, nominal, values)
+    if named:
+        richer = {form for name in named for form in EFFECTS[name].richer}
+        pool = [s for s in signatures if (s.kind, s.channel) in richer]
+    else:  # a rival with a formula: ``other`` repeats whatever repeats, every effect at
+        # once, and beat the one of three it was set against (a gauge low-pass)
+        pool = [s for s in signatures if s.passes and s.kind != "other"]
+    if not pool:
+        return None
+    best = min(pool, key=lambda s: s.excess_after)
+    name = f"{best.kind} in {best.channel}"
+    if named:
+        return None if beats(traces, effect, fits[name].outputs) else name
+    return name if beats(traces, fits[name].outputs, effect) else None
+
+
+def strongest_accepted(
+    ranking: Sequence[RankedEffect], evidence: dict[str, Evidence], tests: int
+) -> str | None:
+    """The best held-out closure among the candidates whose evidence holds, or None.
+
+    The family test (``decide.judge``; Bonferroni over ``tests`` for evidence judged
+    alone) bounds the chance that *any* candidate passes by luck, so a candidate may be
+    named although a better-closing one is not: on a light
+    string-mode and stick-slip campaign the stick-slip refit closed 0.18 at p 0.0093
+    (× 9: fails), the string modes 0.14 at p 0.00096; only the first was tested, and the
+    answer was ``none``.
+    """
+    for line in ranking:  # best closure first
+        if line.effect in evidence and evidence[line.effect].accepted(tests):
+            return line.effect
+    return None
+
+
+def ranking_of(
+    order: Sequence[str],
+    scores: dict[str, float],
+    refits: dict[str, Fitted],
+    evidence: dict[str, Evidence],
+    x_base: float,
+    traces: Sequence[Trace],
+) -> list[RankedEffect]:
+    """Every candidate alone on the baseline, best held-out closure first."""
+    ranking = []
+    for effect in order:
+        line = RankedEffect(effect, screening=scores[effect])
+        if effect in refits:
+            fitted = refits[effect]
+            line.score = closure(x_base, fitted.excess, x_base)
+            line.heldout_error = heldout_error(traces, fitted.outputs)
+            line.heldout_excess = fitted.excess
+            line.p_value = evidence[effect].p_value
+            line.p_family = evidence[effect].p_family
+            line.params = effect_params(effect, fitted.result.values)
+            line.at_bound = bound_params(fitted.result, effect)
+        ranking.append(line)
+    ranking.sort(key=lambda r: (r.score is None, -(r.score or 0.0), -r.screening))
+    return ranking
+
+
+def indistinguishable(
+    chosen: str,
+    refits: dict[str, Fitted],
+    evidence: dict[str, Evidence],
+    traces: Sequence[Trace],
+    tests: int,
+) -> list[str]:
+    """Other candidates that explain the gap about as well as the chosen one.
+
+    Each must be accepted against the baseline on its own, and the chosen one must not
+    beat it on the held-out cycles (``beats``).
+    """
+    return [
+        effect
+        for effect, fitted in refits.items()
+        if effect != chosen
+        and evidence[effect].accepted(tests)
+        and not beats(traces, refits[chosen].outputs, fitted.outputs)
+    ]
+
+
+def beats(traces: Sequence[Trace], chosen: Sequence[Outputs], other: Sequence[Outputs]) -> bool:
+    """Whether ``chosen`` predicts the held-out cycles better than ``other``, by evidence.
+
+    By the standard that names an effect against the baseline: a gain consistent over the
+    blocks (one-sided p ≤ ``DISTINCT_P``) and at least X's resolution
+    (``Evidence.least_gain``). Consistency alone is not a difference: on the other stand's
+    brisk recordings a force skew beat a gauge low-pass on most blocks by a hair (X 4.46
+    against 4.50, p < 0.05) while the truth was a low-pass, and the low-pass went unnamed.
+    """
+    return compare(traces, other, chosen).accepted(tests=1, alpha=DISTINCT_P)
+
+
+def further_effect(
+    named: tuple[str, ...],
+    current: Fitted,
+    trained: dict[str, float],
+    alone: dict[str, dict[str, float]],
+    base_cost: float,
+    pool: Sequence[str],
+    traces: Sequence[Trace],
+    nominal: StandParams,
+    x_base: float,
+    say: Progress,
+) -> tuple[tuple[AcceptedEffect, Fitted] | None, int]:
+    """The best further effect on top of those ``named``, if the held-out cycles say so.
+
+    The candidates tried are the best by a score test on top of those named (screening
+    with their fit as the base, on the training cycles) — an effect that the first one
+    hides explains nothing alone until the first is modelled — and the best by their
+    training cost alone on the baseline (``trained``, below the baseline's ``base_cost``;
+    a Maxwell branch that a force skew mimics in the score test). Both are chosen on the
+    training cycles, so the held-out ones judge them unseen, as one family against the
+    model of those named. (Chosen by their held-out closure alone, a heavy pulley's inertia behind a
+    gauge low-pass was never tried: its refit fitted the training cycles third best,
+    0.028 against the baseline's 0.039, but closed −0.2 against the best baseline.)
+    Each try's start grid also holds its own refit alone (``alone``: its parameters
+    there), a basin the training cycles have shown already.
+    """
+    first = "+".join(named)
+    others = [e for e in pool if e not in named]
+    if not others:
+        return None, 0
+    say(f"screening the other effects on top of {first}")
+    scores, probes, sims = screen(traces, nominal, current.result, current.outputs, others)
+    tries = second_tries(others, scores, trained, base_cost)
+    fits: dict[str, Fitted] = {}
+    for effect in tries:
+        say(f"refitting {effect} on top of {first}")
+        probe = [probes[effect]] if effect in probes else []
+        probe += data_starts(effect, traces, nominal, current.result.values)
+        probe += [alone[effect]] if effect in alone else []
+        fits[effect] = refit(
+            Candidate.build(*named, effect), traces, nominal, current.result.values, probe
+        )
+        sims += fits[effect].result.evaluations
+    evidence = judge(traces, current.outputs, {e: f.outputs for e, f in fits.items()})
+    # The best held-out error among those whose evidence holds (as for the first).
+    passing = [e for e in tries if evidence[e].accepted(len(tries))]
+    if not passing:
+        return None, sims
+    effect = min(passing, key=lambda e: fits[e].excess)
+    ev = evidence[effect]
+    fitted = polish(fits[effect], traces, nominal)
+    sims += fitted.result.evaluations
+    line = AcceptedEffect(
+        effect,
+        closure(current.excess, fitted.excess, x_base),
+        ev.corrected_p(len(tries)),
+        effect_params(effect, fitted.result.values),
+        bound_params(fitted.result, effect),
+    )
+    return (line, fitted), sims
+
+
+def second_tries(
+    others: Sequence[str], scores: dict[str, float], trained: dict[str, float], base_cost: float
+) -> list[str]:
+    """The candidates tried on top of those named (``further_effect``), in order.
+
+    ``SECOND_STAGE`` best by the score test on top (``scores``, only those above 0), then
+    up to ``SECOND_STAGE`` best by their training cost alone (``trained``) among those
+    below the baseline's ``base_cost``.
+    """
+    tries = [e for e in sorted(others, key=lambda e: -scores[e]) if scores[e] > 0.0]
+    tries = tries[:SECOND_STAGE]
+    alone = sorted(
+        (e for e in others if trained.get(e, base_cost) < base_cost), key=trained.__getitem__
+    )
+    return tries + [e for e in alone[:SECOND_STAGE] if e not in tries]
