@@ -470,7 +470,9 @@ def _ranking(
         line = RankedEffect(effect, screening=scores[effect])
         if effect in refits:
             fitted = refits[effect]
-            line.score = _closure(x_base, fitted.excess, x_base)
+            # Not floored: the report shows how much worse a candidate makes it (its
+            # chart clips the bar and says so); a floor drew seven of nine at -1.
+            line.score = (x_base - fitted.excess) / max(x_base - 1.0, 1e-12)
             line.heldout_error = heldout_error(traces, fitted.outputs)
             line.heldout_excess = fitted.excess
             line.p_value = evidence[effect].p_value
