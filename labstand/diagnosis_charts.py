@@ -90,7 +90,7 @@ def where_plot(path: Path, result: Diagnosis) -> None:
     where = result.where
     panels = (("phase of the drive", where.phase), ("regime", where.regime),
               ("frequency band", where.band))  # fmt: skip
-    fig, axes = plt.subplots(len(panels), 1, figsize=(6.4, 3.4), sharex=True,
+    fig, axes = plt.subplots(len(panels), 1, figsize=(6.4, 2.9), sharex=True,
                              layout="constrained")  # fmt: skip
     channels = list(where.channel)
     for ax, (title, shares) in zip(axes, panels, strict=True):

@@ -161,9 +161,16 @@ def provenance_section(provenance: Mapping[str, Any] | None, result: Diagnosis) 
 <p>Stand: {html.escape(str(stand.get("label")))}{stand_hash}, parameter set
 <code>{html.escape(str(stand.get("parameter_set")))}</code>.
 Written by labstand {html.escape(str(provenance.get("labstand_version")))} on
-{html.escape(str(provenance.get("created_utc")))}; {result.simulations} simulations,
-{number(result.timings_s.get("total"), 3)} s. The same record is <code>provenance</code> in
+{html.escape(str(provenance.get("created_utc")))}{_cost(result)}. The same record is
+<code>provenance</code> in
 <a href="result.json">result.json</a>.</p>"""
+
+
+def _cost(result: Diagnosis) -> str:
+    total = result.timings_s.get("total")
+    if total is None:
+        return ""
+    return f"; {result.simulations} simulations in {total:.3g} s"
 
 
 def _signal(signal: Mapping[str, Any] | None) -> str:
