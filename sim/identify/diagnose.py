@@ -470,8 +470,8 @@ def _ranking(
         line = RankedEffect(effect, screening=scores[effect])
         if effect in refits:
             fitted = refits[effect]
-            # Not floored: the report shows how much worse a candidate makes it (its
-            # chart clips the bar and says so); a floor drew seven of nine at -1.
+            # Not floored: how much worse a candidate makes it is part of the answer
+            # (the report's chart clips such a bar and says so); at a floor they look alike.
             line.score = (x_base - fitted.excess) / max(x_base - 1.0, 1e-12)
             line.heldout_error = heldout_error(traces, fitted.outputs)
             line.heldout_excess = fitted.excess
