@@ -5,25 +5,42 @@ from __future__ import annotations
 import math
 import textwrap
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
 from labstand.plots import pyplot
 from sim.identify import Diagnosis
 
-__all__ = ["CLIP_CLOSURE", "per_recording_plot", "ranking_plot", "where_plot"]
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
+__all__ = [
+    "CLIP_CLOSURE",
+    "per_recording_figure",
+    "per_recording_plot",
+    "ranking_figure",
+    "ranking_plot",
+    "where_plot",
+]
 
 #: The ranking's axis starts here: a candidate that makes the held-out error several
 #: times worse would squash every other bar; its bar ends here, marked and labelled.
 CLIP_CLOSURE = -1.0
-#: Colours of the categories of each breakdown (phase, regime, band), in their order.
 #: Characters in a line of a per-recording panel's title (3.9 in wide at 8 pt).
 TITLE_WIDTH = 44
+#: Colours of the categories of each breakdown (phase, regime, band), in their order.
 _PALETTE = ("tab:red", "tab:orange", "tab:blue", "tab:gray", "tab:green", "tab:purple")
 
 
 def ranking_plot(path: Path, result: Diagnosis) -> None:
+    """``ranking_figure`` into a PNG."""
+    fig = ranking_figure(result)
+    fig.savefig(path, dpi=90)
+    pyplot().close(fig)
+
+
+def ranking_figure(result: Diagnosis) -> Figure:
     """Each candidate alone on the baseline: its held-out gap closure and screening share.
 
     Closures below ``CLIP_CLOSURE`` are drawn to it, hatched, with the real value written
@@ -62,8 +79,7 @@ def ranking_plot(path: Path, result: Diagnosis) -> None:
     ax.legend(handles=_ranking_legend(any_clipped), fontsize=8, loc="lower right")
     answer = " + ".join(e.effect for e in result.effects) or "none"
     ax.set_title(f"Each candidate alone — named: {answer} (bold)", fontsize=10, loc="left")
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
+    return cast("Figure", fig)
 
 
 def _ranking_legend(clipped: bool) -> list[Any]:
@@ -125,15 +141,26 @@ def _patch(colour: str, label: str) -> Any:
 
 
 def per_recording_plot(path: Path, result: Diagnosis) -> bool:
+    """``per_recording_figure`` into a PNG; False (no file) where there is nothing to draw."""
+    fig = per_recording_figure(result)
+    if fig is None:
+        return False
+    fig.savefig(path, dpi=90)
+    pyplot().close(fig)
+    return True
+
+
+def per_recording_figure(result: Diagnosis) -> Figure | None:
     """Each parameter fitted per recording against its drive rate, with its interval.
 
-    False (nothing drawn) where the diagnosis has no per-recording fits. A parameter's
-    panel title carries the consistency test's p-value and the trend it names.
+    None where the diagnosis has no per-recording fits. A parameter's panel title
+    carries the consistency test's p-value and the trend it names; recordings without a
+    stored drive rate are drawn side by side, numbered.
     """
     fits = result.per_recording
     names = sorted({n for fit in fits.values() for n in fit.get("params", {})})
     if not names:
-        return False
+        return None
     plt = pyplot()
     cols = min(3, len(names))
     rows = math.ceil(len(names) / cols)
@@ -148,8 +175,10 @@ def per_recording_plot(path: Path, result: Diagnosis) -> bool:
             value = _number(fits[rec].get("params", {}).get(name))
             if not math.isfinite(value):
                 continue
-            lo, hi = fits[rec].get("intervals", {}).get(name, (value, value))
-            err = [[max(value - lo, 0.0)], [max(hi - value, 0.0)]]
+            lo, hi = (_number(v) for v in fits[rec].get("intervals", {}).get(name, (value, value)))
+            # no bar where the interval is missing or not finite (a point alone)
+            below, above = (value - lo, hi - value) if math.isfinite(lo + hi) else (0.0, 0.0)
+            err = [[max(below, 0.0)], [max(above, 0.0)]]
             ax.errorbar([x], [value], yerr=err, fmt="o", capsize=4,
                         color=_PALETTE[k % len(_PALETTE)], label=rec)  # fmt: skip
         ax.set_title(_consistency_title(name, result.consistency.get(name)), fontsize=8,
@@ -166,9 +195,7 @@ def per_recording_plot(path: Path, result: Diagnosis) -> bool:
     handles, labels = axes[0, 0].get_legend_handles_labels()
     fig.legend(handles, labels, loc="outside upper center", ncol=min(len(labels), 4),
                fontsize=8)  # fmt: skip
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
-    return True
+    return cast("Figure", fig)
 
 
 def _consistency_title(name: str, test: dict[str, Any] | None) -> str:
