@@ -145,7 +145,7 @@ def provenance_section(provenance: Mapping[str, Any] | None, result: Diagnosis) 
         f'</small></td><td><code class="hash">{html.escape(str(r["sha256"]))}</code></td>'
         f"<td>{r['mass_kg']:g} kg<br><small>{html.escape(str(r['mass_source']))}</small></td>"
         f"<td>{_signal(r.get('signal'))}</td>"
-        f"<td>{html.escape(str(r.get('backend') or '—'))}<br><small>"
+        f"<td>{html.escape(str(r.get('backend') or '—'))}{_simulated(r)}<br><small>"
         f"{html.escape(str(r.get('start_time_utc') or ''))}</small></td></tr>"
         for r in provenance.get("recordings", [])
     )
@@ -173,10 +173,24 @@ def _cost(result: Diagnosis) -> str:
     return f"; {result.simulations} simulations in {total:.3g} s"
 
 
+def _simulated(recording: Mapping[str, Any]) -> str:
+    """The effects a simulated recording was made with (the truth a check compares to)."""
+    effects = recording.get("simulated_effects") or []
+    named = [
+        f"{html.escape(str(e.get('name')))} ("
+        + ", ".join(f"{html.escape(str(k))} {number(v)}" for k, v in e.get("params", {}).items())
+        + ")"
+        for e in effects
+    ]
+    return f", with {'; '.join(named)}" if named else ""
+
+
 def _signal(signal: Mapping[str, Any] | None) -> str:
     if not signal:
         return '<span class="muted">not stored in the recording</span>'
     parts = [html.escape(str(signal.get("shape", "?")))]
+    if "situation" in signal:  # the paper's numbering
+        parts[0] = f"situation {html.escape(str(signal['situation']))}: {parts[0]}"
     for key, unit in (("amplitude_mm", "mm"), ("frequency_hz", "Hz"), ("cycles", "cycles")):
         if key in signal:
             parts.append(f"{number(signal[key])} {unit}")

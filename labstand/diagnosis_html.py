@@ -173,8 +173,8 @@ def _how_sure(result: Diagnosis) -> str:
     return (
         "<table><tr><th>parameter</th><th>fitted</th><th>95 % interval</th></tr>"
         f'{"".join(rows)}</table><p class="muted">{method} '
-        '<span class="bound">at its bound</span>: the interval reaches the end of the '
-        "parameter's physical range — the effect may be larger, or of another form.</p>"
+        '<span class="bound">at its bound</span>: the fit or its interval reaches the end of '
+        "the parameter's physical range — the effect may be larger, or of another form.</p>"
     )
 
 
