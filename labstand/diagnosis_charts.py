@@ -77,8 +77,9 @@ def ranking_figure(result: Diagnosis) -> Figure:
     ax.set_xlabel("held-out gap closure (1 = to the noise; < 0: worse than the baseline)")
     any_clipped = any(r.score is not None and r.score < CLIP_CLOSURE for r in result.ranking)
     ax.legend(handles=_ranking_legend(any_clipped), fontsize=8, loc="lower right")
-    answer = " + ".join(e.effect for e in result.effects) or "none"
-    ax.set_title(f"Each candidate alone — named: {answer} (bold)", fontsize=10, loc="left")
+    answer = " + ".join(e.effect for e in result.effects)
+    title = f"named: {answer} (bold)" if answer else "none named"
+    ax.set_title(f"Each candidate alone — {title}", fontsize=10, loc="left")
     return cast("Figure", fig)
 
 

@@ -132,17 +132,12 @@ def _best_unnamed(result: Diagnosis) -> str:
 
 
 def _how_sure(result: Diagnosis) -> str:
-    from sim.identify.fitting import BASELINE_PARAMS, Candidate
+    from sim.identify.fitting import BASELINE_PARAMS
 
     rows = []
     for e in result.effects:
         rows.append(f'<tr><th colspan="3">{html.escape(e.effect)}</th></tr>')
-        prefix = f"{e.effect}."
-        free = {
-            p.name[len(prefix) :]: p
-            for p in Candidate.build(e.effect).params
-            if p.name.startswith(prefix)
-        }
+        free = _ranges(e.effect)
         for name, value in e.params.items():
             interval = e.intervals.get(name)
             reaches = name in e.at_bound or (
@@ -176,6 +171,18 @@ def _how_sure(result: Diagnosis) -> str:
         '<span class="bound">at its bound</span>: the fit or its interval reaches the end of '
         "the parameter's physical range — the effect may be larger, or of another form.</p>"
     )
+
+
+def _ranges(effect: str) -> dict[str, FreeParam]:
+    """An effect's fitted parameters with their ranges (none for a name not in the catalogue)."""
+    from sim.identify.fitting import Candidate
+
+    try:
+        params = Candidate.build(effect).params
+    except KeyError:
+        return {}
+    prefix = f"{effect}."
+    return {p.name[len(prefix) :]: p for p in params if p.name.startswith(prefix)}
 
 
 def _reaches(free: FreeParam, value: float) -> bool:
