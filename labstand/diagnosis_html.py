@@ -125,9 +125,11 @@ def _best_unnamed(result: Diagnosis) -> str:
     if not tried:
         return "No candidate was refitted."
     best = tried[0]
+    closes = f"closes {best.score:.0%}" if best.score and best.score > 0 else "closes none"
+    weak = best.p_family is None or best.p_family > result.alpha
     return (
-        f"The best candidate, {html.escape(best.effect)}, closes {best.score:.0%} of the "
-        f"held-out gap at family p = {number(best.p_family, 2)}: not enough to name it."
+        f"The best candidate, {html.escape(best.effect)}, {closes} of the held-out gap at "
+        f"family p = {number(best.p_family, 2)}{': not enough to name it' if weak else ''}."
     )
 
 

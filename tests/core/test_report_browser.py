@@ -194,3 +194,19 @@ def test_a_diagnosis_without_intervals_says_they_were_not_computed(
     assert "Parameters fitted per recording: not computed" in page
     assert not (index.parent / "per_recording.png").exists()
     assert json.loads((index.parent / "result.json").read_text())["provenance"] is None
+
+
+def test_with_nothing_named_the_first_screen_says_so_and_names_the_best_try(
+    stand: StandConfig, tmp_path: Path
+) -> None:
+    traces, result, provenance = _campaign(stand, tmp_path)
+    result.effects, result.verdict = [], "baseline_adequate"
+    result.ranking[0].score, result.ranking[0].p_family = 0.05, 0.4
+    page = write_report(tmp_path / "report", traces, result, provenance).read_text()
+    which = _section(page, "which")
+    assert "<b>Baseline adequate</b>: no systematic gap beyond the noise; no effect named." in which
+    assert (
+        "fibre_viscoelastic, closes 5% of the held-out gap at family p = 0.4: not enough" in which
+    )
+    sure = _section(page, "how-sure")
+    assert "fibre_viscoelastic" not in sure and "<code>stiffness_scale</code>" in sure
