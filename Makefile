@@ -6,7 +6,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 OUT := out
-SYSTEM_TOOLS := mbpoll socat h5dump
+SYSTEM_TOOLS := mbpoll socat h5dump chromium
 
 .PHONY: demo test lint system-tools node-tools lock bench clean
 
@@ -33,7 +33,7 @@ system-tools:
 	@missing=""; for t in $(SYSTEM_TOOLS); do command -v $$t >/dev/null || missing="$$missing $$t"; done; \
 	if [ -n "$$missing" ]; then \
 	  echo "installing Debian tools for the tests:$$missing"; \
-	  apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq mbpoll socat hdf5-tools >/dev/null; \
+	  apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq mbpoll socat hdf5-tools chromium >/dev/null; \
 	fi
 
 # The independent Foxglove WebSocket client of the live-view tests (@foxglove/ws-protocol,

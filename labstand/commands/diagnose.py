@@ -80,7 +80,8 @@ def run(args: argparse.Namespace) -> int:
     """Read, diagnose, report (or, with --campaigns, every campaign of a manifest)."""
     from labstand.campaigns import trace_of, unique_names
     from labstand.commands.diagnose_many import run_campaigns
-    from labstand.diagnosis_report import write_report
+    from labstand.diagnosis_report import report_json, write_report
+    from labstand.provenance import RecordingSource, build_provenance
     from recordings import RecordingError, open_recording
     from sim.config import load_config
     from sim.identify import DiagnosisInputError, diagnose
@@ -103,6 +104,7 @@ def run(args: argparse.Namespace) -> int:
         raise CommandError(f"mass must be > 0 kg, got {args.mass_kg:g} kg", ExitCode.USAGE)
     traces = []
     masses: dict[str, dict[str, float | str]] = {}
+    sources = []  # per recording, even one given twice: (path, kg, source, metadata)
     for path in args.recordings:
         try:
             rec = open_recording(path)
@@ -110,17 +112,29 @@ def run(args: argparse.Namespace) -> int:
             mass, source = _mass_of(path, rec.metadata.stand_config, args.mass_kg, stand)
             masses[str(path)] = {"kg": mass, "source": source}
             traces.append(trace_of(path.name, rec.frame(), mass))
+            sources.append((path, mass, source, rec.metadata.to_dict()))
         except (RecordingError, DiagnosisInputError) as err:
             raise CommandError(str(err), ExitCode.USAGE) from None
     traces = unique_names(traces)
+    # Hashed before the diagnosis: the files as read, not as they may be later.
+    provenance = build_provenance(
+        [
+            RecordingSource(path, tr.name, kg, source, meta)
+            for (path, kg, source, meta), tr in zip(sources, traces, strict=True)
+        ],
+        args.stand,
+        args.params,
+    )
 
     def progress(message: str) -> None:
         print(f"labstand diagnose: {message}", file=sys.stderr, flush=True)
 
     result = diagnose(traces, nominal, progress=progress)
-    index = write_report(args.report, traces, result) if args.report is not None else None
+    index = (
+        write_report(args.report, traces, result, provenance) if args.report is not None else None
+    )
     if args.json:
-        out = result.to_dict()
+        out = report_json(result, provenance)
         out["recordings"] = [str(p) for p in args.recordings]
         out["mass_kg"] = masses
         if index is not None:

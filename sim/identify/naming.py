@@ -119,7 +119,9 @@ def ranking_of(
         line = RankedEffect(effect, screening=scores[effect])
         if effect in refits:
             fitted = refits[effect]
-            line.score = closure(x_base, fitted.excess, x_base)
+            # Not floored: how much worse a candidate makes it is part of the answer
+            # (the report's chart clips such a bar and says so); at a floor they look alike.
+            line.score = (x_base - fitted.excess) / max(x_base - 1.0, 1e-12)
             line.heldout_error = heldout_error(traces, fitted.outputs)
             line.heldout_excess = fitted.excess
             line.p_value = evidence[effect].p_value

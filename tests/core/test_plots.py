@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 from labstand.cli import main
-from labstand.diagnosis_report import _fmt
+from labstand.diagnosis_html import _r
 from labstand.plots import pyplot, r_text, replay_figure, run_figure
 from recordings import open_recording
 from recordings.replay import replay
@@ -20,7 +20,7 @@ UNIT = re.compile(r"\[[^\]]+\]$")  # "weight u [mm]", "Δ(F − T₀) [N]"
 
 def test_r_has_six_decimals_where_four_would_read_as_one() -> None:
     assert r_text(0.9999614) == "0.999961"
-    assert _fmt({"R": 0.9999614, "nrmse": 0.0099}) == "R 0.999961, nrmse 0.0099"
+    assert _r({"R": 0.9999614, "nrmse": 0.0099}) == "0.999961"  # the report's how-far table
 
 
 def test_replay_figure_has_units_on_every_axis_and_six_digit_r(

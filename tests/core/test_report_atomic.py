@@ -7,7 +7,7 @@ from typing import Any
 
 import pytest
 
-from labstand import diagnosis_report
+from labstand import diagnosis_charts, diagnosis_plots, diagnosis_report
 
 
 def _interrupted_at_the_second_plot(monkeypatch: pytest.MonkeyPatch) -> None:
@@ -17,8 +17,8 @@ def _interrupted_at_the_second_plot(monkeypatch: pytest.MonkeyPatch) -> None:
     def second(path: Path, *_: Any) -> None:
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(diagnosis_report, "_residual_plot", first)
-    monkeypatch.setattr(diagnosis_report, "_ranking_plot", second)
+    monkeypatch.setattr(diagnosis_plots, "residual_plot", first)
+    monkeypatch.setattr(diagnosis_charts, "ranking_plot", second)
 
 
 def test_an_interrupted_report_leaves_no_folder(

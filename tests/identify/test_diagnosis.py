@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import hashlib
 import json
 from pathlib import Path
 
@@ -126,6 +127,17 @@ def test_diagnose_command_on_csv_recordings_with_report(
     assert out["effects"][0]["p_value"] == named["p_family"] <= 0.05
     page = (report / "index.html").read_text()
     assert "dial_gauge_calibration" in page and 'src="ranking.png"' in page
+    # Provenance: the files by their hashes, the mass and where it came from, the stand;
+    # one record that --json, result.json and the page all show.
+    prov = out["provenance"]
+    for path, rec in zip(paths, prov["recordings"], strict=True):
+        digest = hashlib.sha256(Path(path).read_bytes()).hexdigest()
+        assert rec["path"] == path and rec["sha256"] == digest and digest in page
+        assert (rec["mass_kg"], rec["mass_source"]) == (8.131, "--mass-kg")
+        assert rec["signal"] is None  # a CSV import does not say how it was driven
+    assert prov["stand"]["file"] is None and prov["stand"]["parameter_set"] == "final"
+    assert prov["labstand_version"] and prov["created_utc"].startswith("20")
+    assert json.loads((report / "result.json").read_text())["provenance"] == prov
     for png in ("ranking.png", "residual.png", "overlay.png"):
         assert (report / png).read_bytes()[:4] == b"\x89PNG"
 
