@@ -324,11 +324,19 @@ class Objective:
             self._cache = {key: self.residuals_batch(np.atleast_2d(z))[0]}
         return self._cache[key]
 
-    def jacobian(self, z: FloatArray, columns: NDArray[np.bool_] | None = None) -> FloatArray:
-        """Forward differences of the chosen columns (default: all), in one batch."""
+    def jacobian(
+        self,
+        z: FloatArray,
+        columns: NDArray[np.bool_] | None = None,
+        steps: FloatArray | None = None,
+    ) -> FloatArray:
+        """Forward differences of the chosen columns (default: all), in one batch.
+
+        ``steps``: each parameter's step (optimiser coordinates; default 1e-3 of its range).
+        """
         lo = np.array([p.bounds()[0] for p in self.candidate.params])
         hi = np.array([p.bounds()[1] for p in self.candidate.params])
-        step = 1e-3 * (hi - lo)
+        step = 1e-3 * (hi - lo) if steps is None else steps
         which = np.flatnonzero(np.ones(z.size, bool) if columns is None else columns)
         # least_squares has just asked for the residuals at z: they are memoised.
         key = np.asarray(z, dtype=np.float64).tobytes()
