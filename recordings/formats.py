@@ -28,7 +28,6 @@ if TYPE_CHECKING:
 
 __all__ = [
     "FORMATS",
-    "TABLE_SUFFIXES",
     "Format",
     "format_for",
     "reader_for",
@@ -97,10 +96,6 @@ FORMATS: Mapping[str, Format] = MappingProxyType(
         ".tdms": Format("TDMS", "recordings.tdmsio:read_tdms"),  # foreign: read only
     }
 )
-
-#: Suffixes written as one table on the gauge clock (not streaming: ``labstand run``
-#: refuses them).
-TABLE_SUFFIXES = tuple(s for s, f in FORMATS.items() if f.table_writer)
 
 
 def suffixes(*roles: Role) -> list[str]:
