@@ -24,9 +24,9 @@ import cloudpickle
 from labstand.commands.diagnose_check import CheckSetup, check_job, run_cases
 from labstand.distributed import ClusterOptions, Progress, open_client
 from labstand.distributed.jobs import call_job
+from sim.checks.check import SMALL_CAMPAIGN, check_cases
+from sim.checks.otherstand.campaign import OTHER_SMALL
 from sim.config import default_config
-from sim.identify.check import SMALL_CAMPAIGN, check_cases
-from sim.otherstand.campaign import OTHER_SMALL
 
 CLASSES = ["none", "fibre_viscoelastic", "dial_gauge_calibration", "stick_slip_friction"]
 MASSES = [3.096, 8.131]

@@ -17,9 +17,9 @@ import time
 import numpy as np
 
 from drivers.signals import SignalSpec
+from sim.checks.check import make_campaign
 from sim.config import default_config
 from sim.identify import diagnose
-from sim.identify.check import make_campaign
 from sim.situations import situation
 
 

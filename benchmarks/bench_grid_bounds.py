@@ -25,9 +25,9 @@ import numpy as np
 
 from labstand.campaigns import trace_of
 from recordings import open_recording
+from sim.checks.check import CaseSpec, make_campaign
 from sim.config import default_config, load_config
 from sim.effects import EFFECTS
-from sim.identify.check import CaseSpec, make_campaign
 from sim.identify.fitting import Candidate, effect_grid_points, fit, trace_costs
 from sim.identify.least_cost import FloatArray, TraceCost, least_cost_point
 from sim.identify.shooting import dial_slope

@@ -1,7 +1,7 @@
 """Benchmark: the other truth stand's simulator per 10 s recording, beside the baseline model.
 
 A 10 s recording at 2 kHz (a 30 mm, 1 Hz trapezoid that slackens the fibre, 9 cycles,
-0.5 s rest each side) of the heavy weight: ``sim.otherstand.simulate`` without effects,
+0.5 s rest each side) of the heavy weight: ``sim.checks.otherstand.simulate`` without effects,
 with each physical effect, and with all of them at once; beside it, as the reference in
 the same run, ``sim.model.Model(stand).run`` (the baseline kernel) and with a candidate
 effect. Median of five runs each, compile time excluded.
@@ -17,10 +17,10 @@ from collections.abc import Callable
 import numpy as np
 
 from drivers.signals import Shape, SignalSpec, plan_motion
+from sim.checks.otherstand import OTHER_EFFECTS, simulate
 from sim.config import default_config
 from sim.effects import EffectSpec
 from sim.model import Model
-from sim.otherstand import OTHER_EFFECTS, simulate
 
 RATE = 2000.0
 

@@ -21,9 +21,9 @@ from typing import Any
 
 import numpy as np
 
+from sim.checks.check import MASSES_KG, CaseSpec, make_campaign
 from sim.config import default_config
 from sim.identify import decide, heldout
-from sim.identify.check import MASSES_KG, CaseSpec, make_campaign
 from sim.identify.heldout import Outputs
 from sim.identify.traces import Trace
 

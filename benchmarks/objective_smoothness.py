@@ -21,8 +21,8 @@ import json
 
 import numpy as np
 
+from sim.checks.check import CaseSpec, make_campaign
 from sim.config import default_config
-from sim.identify.check import CaseSpec, make_campaign
 from sim.identify.fitting import Candidate, Objective
 from sim.identify.shooting import dial_slope
 

@@ -11,11 +11,13 @@ from drivers.signals import DriveProfile
 from labstand.errors import CommandError, ExitCode
 from recordings.convert import write_streams
 from recordings.csvio import write_csv
+from recordings.formats import suffixes
 from recordings.schema import COMMAND_DTYPE, GAUGES_DTYPE, Backend, make_metadata
 from sim.config import StandConfig
 from sim.results import SimResult
 
-SUFFIXES = (".csv", ".mcap", ".h5", ".hdf5")
+#: The simulation's four columns as CSV, or a full recording through a streaming writer.
+SUFFIXES = (".csv", *suffixes("write"))
 
 
 def write_simulation(

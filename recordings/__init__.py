@@ -4,6 +4,7 @@
 ``open_recording(path)`` reads ``.mcap``, ``.h5``/``.hdf5``, ``.csv``, ``.parquet`` and
 ``.tdms`` into a checked ``Recording`` (``.metadata``, ``.frame()``, ``.drive_states()``,
 ``.events()``).
+Which suffix is read and written by what: one table, ``recordings.formats.FORMATS``.
 
 Exceptions::
 

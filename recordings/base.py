@@ -1,4 +1,4 @@
-"""The writer ABC, the in-memory recording every reader returns, and the suffix registry.
+"""The writer ABC, the stream checks, and ``open_writer`` (the format by its suffix).
 
 Writers stream: each ``write_*`` call appends a block and the file is pushed to the
 operating system at least every ``flush_interval_s`` of data (and of wall time), so a
@@ -8,20 +8,19 @@ killed process loses at most the last second. A writer is thread-confined: one t
 
 from __future__ import annotations
 
-import importlib
 import logging
 import math
 import time
 from abc import ABC, abstractmethod
-from collections.abc import Callable
 from pathlib import Path
-from typing import Any, ClassVar
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 from drivers.closing import ClosesOnExit
-from recordings.errors import InvalidDataError, UnknownFormatError, WriterClosedError
+from recordings.errors import InvalidDataError, WriterClosedError
+from recordings.formats import writer_for
 from recordings.schema import (
     COMMAND_DTYPE,
     DRIVE_DTYPE,
@@ -32,16 +31,7 @@ from recordings.schema import (
     as_block,
 )
 
-__all__ = [
-    "EVENTS_DTYPE",
-    "FORMATS",
-    "RecordingWriter",
-    "check_stream",
-    "formats",
-    "open_writer",
-    "reader_for",
-    "register_format",
-]
+__all__ = ["EVENTS_DTYPE", "RecordingWriter", "check_stream", "open_writer"]
 
 log = logging.getLogger(__name__)
 
@@ -107,8 +97,6 @@ class RecordingWriter(ClosesOnExit, ABC):
     flush_interval_s
         Push buffered data to the OS at least this often, in data time and in wall time, s.
     """
-
-    suffixes: ClassVar[tuple[str, ...]] = ()
 
     def __init__(
         self, path: Path, metadata: RecordingMetadata, flush_interval_s: float = 0.5
@@ -237,73 +225,7 @@ class RecordingWriter(ClosesOnExit, ABC):
             self.flush()
 
 
-WriterFactory = Callable[[Path, RecordingMetadata], RecordingWriter]
-ReaderFunction = Callable[..., Any]  # (path, *, salvage=False) -> Recording
-
-#: suffix -> (format name, writer class or None, reader function or None), filled by the
-#: format modules as they are imported (``register_format``); ``formats()`` imports them all.
-FORMATS: dict[str, tuple[str, WriterFactory | None, ReaderFunction | None]] = {}
-
-#: Suffixes written as one table on the gauge clock (``recordings.tables``, pandas).
-TABLE_SUFFIXES = (".csv", ".parquet")
-
-#: suffix -> the modules that register its reader and writer. A format module is imported
-#: only when a file of its suffix is opened, so reading an MCAP file does not load h5py
-#: and nptdms (the command's start-up time, docs/benchmarks.md).
-FORMAT_MODULES: dict[str, tuple[str, ...]] = {
-    ".csv": ("recordings.csvio",),
-    ".mcap": ("recordings.mcap_reader", "recordings.mcap_writer"),
-    ".h5": ("recordings.hdf5io",),
-    ".hdf5": ("recordings.hdf5io",),
-    ".tdms": ("recordings.tdmsio",),
-    ".parquet": ("recordings.tables",),  # written by `convert`, read back here
-}
-
-
-def register_format(
-    name: str,
-    suffixes: tuple[str, ...],
-    writer: WriterFactory | None = None,
-    reader: ReaderFunction | None = None,
-) -> None:
-    """Make a format known by its suffixes (lower case, with the dot)."""
-    for suffix in suffixes:
-        _, old_writer, old_reader = FORMATS.get(suffix, (name, None, None))
-        FORMATS[suffix] = (name, writer or old_writer, reader or old_reader)
-
-
-def formats() -> dict[str, tuple[str, WriterFactory | None, ReaderFunction | None]]:
-    """Every known format (``FORMATS``, after importing all format modules)."""
-    for modules in FORMAT_MODULES.values():
-        for module in modules:
-            importlib.import_module(module)
-    return FORMATS
-
-
-def _lookup(path: Path, role: str) -> tuple[str, WriterFactory | None, ReaderFunction | None]:
-    suffix = path.suffix.lower()
-    for module in FORMAT_MODULES.get(suffix, ()):
-        importlib.import_module(module)
-    entry = FORMATS.get(suffix)
-    if entry is None or entry[1 if role == "write" else 2] is None:
-        usable = sorted(s for s, e in formats().items() if e[1 if role == "write" else 2])
-        raise UnknownFormatError(
-            f"{path}: cannot {role} {suffix or 'files without a suffix'!r}; "
-            f"use one of {', '.join(usable)}"
-        )
-    return entry
-
-
 def open_writer(path: str | Path, metadata: RecordingMetadata, **options: Any) -> RecordingWriter:
     """A streaming writer for ``path``, the format chosen by its suffix (.mcap, .h5)."""
     p = Path(path)
-    _, writer, _ = _lookup(p, "write")
-    assert writer is not None
-    return writer(p, metadata, **options)
-
-
-def reader_for(path: Path) -> ReaderFunction:
-    """The reader function for a suffix."""
-    _, _, reader = _lookup(path, "read")
-    assert reader is not None
-    return reader
+    return writer_for(p)(p, metadata, **options)

@@ -18,18 +18,20 @@ A file whose metadata cannot be read this way is left out with its reason (``Ent
 from __future__ import annotations
 
 import os
-from collections.abc import Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from recordings.errors import RecordingError
+from recordings.formats import suffixes
 from recordings.schema import RecordingMetadata
 
-__all__ = ["SUFFIXES", "Entry", "entries", "read_entry"]
+__all__ = ["HEADS", "SUFFIXES", "Entry", "entries", "read_entry"]
 
-#: The formats labstand writes (TDMS is a foreign format: it carries no labstand metadata).
-SUFFIXES = (".mcap", ".h5", ".hdf5", ".csv", ".parquet")
+#: The formats labstand writes (``recordings.formats``; TDMS is a foreign format: it
+#: carries no labstand metadata). Each has a metadata reader below (a test holds them equal).
+SUFFIXES = tuple(suffixes("write", "table"))
 _TAIL_BYTES = 4096
 #: ``recordings.csvio.METADATA_TAG`` (that module imports pandas: 0.3 s)
 CSV_METADATA_TAG = "# labstand-metadata: "
@@ -73,17 +75,12 @@ def entries(paths: Iterable[Path]) -> list[Entry]:
 
 def read_entry(path: Path) -> Entry:
     """The metadata and span of one recording, or the reason it cannot be read."""
-    suffix = path.suffix.lower()
+    head = HEADS.get(path.suffix.lower())
+    if head is None:
+        return Entry(path, None, error=f"no labstand recording: {path.suffix or 'no suffix'!r}")
     where = str(path)
     try:
-        if suffix == ".mcap":
-            text, span = _mcap(path)
-        elif suffix in {".h5", ".hdf5"}:
-            text, span = _hdf5(path)
-        elif suffix == ".csv":
-            text, span = _csv(path)
-        else:
-            text, span = _parquet(path)
+        text, span = head(path)
         meta = RecordingMetadata.from_json(text, where)
     except OSError as err:  # h5py's own OSErrors have no errno: their text then
         return Entry(path, None, error=err.strerror or " ".join(str(err).split()))
@@ -174,3 +171,13 @@ def _parquet(path: Path) -> tuple[str, int | None]:
         lo = stats.min if lo is None else min(lo, stats.min)
         hi = stats.max if hi is None else max(hi, stats.max)
     return extra["labstand.metadata"], None if lo is None or hi is None else int(hi) - int(lo)
+
+
+#: suffix -> its metadata (JSON text) and span (ns, or None), read without the samples.
+HEADS: dict[str, Callable[[Path], tuple[str, int | None]]] = {
+    ".mcap": _mcap,
+    ".h5": _hdf5,
+    ".hdf5": _hdf5,
+    ".csv": _csv,
+    ".parquet": _parquet,
+}

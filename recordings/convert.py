@@ -11,7 +11,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from recordings.atomic import written_whole
-from recordings.base import EVENTS_DTYPE, TABLE_SUFFIXES, open_writer
+from recordings.base import EVENTS_DTYPE, open_writer
+from recordings.formats import format_for
 from recordings.recording import Recording
 from recordings.schema import COMMAND_DTYPE, DRIVE_DTYPE, RecordingMetadata
 
@@ -85,11 +86,11 @@ def write_recording(
     for line in recording.repairs:
         t_ns = int(recording.gauges["t_ns"][-1]) if len(recording.gauges) else 0
         events.append((t_ns, "repair", line))
-    if path.suffix.lower() in TABLE_SUFFIXES:
-        from recordings.tables import write_table  # pandas: only when a table is written
-
+    fmt = format_for(path, "write", "table")  # refused before anything is written
+    if fmt.table_writer:  # pandas (and pyarrow) only when a table is written
         array = np.array(events, dtype=EVENTS_DTYPE).reshape(len(events))
-        write_table(dataclasses.replace(recording, events_array=array, repairs=[]), path, meta)
+        table = dataclasses.replace(recording, events_array=array, repairs=[])
+        fmt.load("table")(table, path, meta)
     else:
         write_streams(path, meta, recording.gauges, recording.command, recording.drive, events)
     log.info("wrote %s (%d samples)", path, len(recording.gauges))

@@ -20,7 +20,7 @@ import pandas as pd
 from numpy.typing import NDArray
 
 from recordings.atomic import written_whole
-from recordings.base import EVENTS_DTYPE, register_format
+from recordings.base import EVENTS_DTYPE
 from recordings.csvtext import CsvOptions, CsvText, split_csv
 from recordings.errors import (
     CorruptRecordingError,
@@ -203,6 +203,3 @@ def read_csv(
         recording.events_array = np.array(events, dtype=EVENTS_DTYPE).reshape(len(events))
         recording.drive = drive_array(kept.drive, where)
     return recording
-
-
-register_format("CSV", (".csv",), reader=read_csv)

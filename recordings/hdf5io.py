@@ -37,7 +37,7 @@ import h5py
 import numpy as np
 from numpy.typing import NDArray
 
-from recordings.base import EVENTS_DTYPE, RecordingWriter, register_format
+from recordings.base import EVENTS_DTYPE, RecordingWriter
 from recordings.errors import (
     CorruptRecordingError,
     MissingChannelError,
@@ -62,7 +62,6 @@ __all__ = ["CheckedHdf5", "Hdf5RecordingWriter", "checked_hdf5", "read_hdf5"]
 
 log = logging.getLogger(__name__)
 
-SUFFIXES = (".h5", ".hdf5")
 _STR = h5py.string_dtype("utf-8")
 _LOW_RATE_CHUNK = 256
 GZIP_LEVEL = 1  # level 4 saves 3 % of the size and costs 35 % more time (benchmark)
@@ -142,8 +141,6 @@ class Hdf5RecordingWriter(RecordingWriter):
     compress
         Shuffle + gzip the 2 kHz streams (default); False reads 3× faster, 3× larger.
     """
-
-    suffixes = SUFFIXES
 
     def __init__(
         self,
@@ -358,6 +355,3 @@ def read_hdf5(path: Path, *, salvage: bool = False) -> Recording:
         events_array=streams["events"],
         repairs=h5.repairs,
     )
-
-
-register_format("HDF5", SUFFIXES, writer=Hdf5RecordingWriter, reader=read_hdf5)

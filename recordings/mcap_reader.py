@@ -21,7 +21,7 @@ from mcap.exceptions import EndOfFile, McapError
 from mcap.records import Channel, Chunk, Metadata, Schema
 from numpy.typing import NDArray
 
-from recordings.base import EVENTS_DTYPE, register_format
+from recordings.base import EVENTS_DTYPE
 from recordings.errors import (
     CorruptRecordingError,
     MissingChannelError,
@@ -320,6 +320,3 @@ def read_mcap(path: Path, *, salvage: bool = False) -> Recording:
         events_array=events,
         repairs=walk.repairs,
     )
-
-
-register_format("MCAP", (".mcap",), reader=read_mcap)

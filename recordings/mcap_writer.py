@@ -31,7 +31,7 @@ import numpy as np
 from mcap.writer import CompressionType, Writer
 from numpy.typing import NDArray
 
-from recordings.base import RecordingWriter, register_format
+from recordings.base import RecordingWriter
 from recordings.errors import InvalidDataError
 from recordings.proto import (
     DRIVE_STATE,
@@ -123,8 +123,6 @@ class McapRecordingWriter(RecordingWriter):
         draws the batches at full rate (x-axis "Message path" ``/gauges.t_s[:]``);
         False writes the layout before it (readers need neither).
     """
-
-    suffixes = (".mcap",)
 
     def __init__(
         self,
@@ -268,6 +266,3 @@ class McapRecordingWriter(RecordingWriter):
             self._writer.finish()  # type: ignore[no-untyped-call]
         finally:
             self._file.close()
-
-
-register_format("MCAP", McapRecordingWriter.suffixes, writer=McapRecordingWriter)

@@ -11,8 +11,9 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
-from recordings.base import EVENTS_DTYPE, check_stream, reader_for
+from recordings.base import EVENTS_DTYPE, check_stream
 from recordings.errors import InvalidDataError
+from recordings.formats import reader_for
 from recordings.schema import (
     COMMAND_DTYPE,
     DRIVE_DTYPE,
@@ -205,12 +206,12 @@ class Recording:
 def open_recording(
     path: str | Path, *, salvage: bool = False, log_repairs: bool = True
 ) -> Recording:
-    """Read a recording (.mcap, .h5/.hdf5) or a foreign run (.csv, .tdms), checked.
+    """Read a recording (.mcap, .h5/.hdf5, .csv, .parquet) or a foreign run (.csv, .tdms), checked.
 
     Parameters
     ----------
     path
-        The file; its suffix picks the reader.
+        The file; its suffix picks the reader (``recordings.formats.FORMATS``).
     salvage
         Read what can be read from a damaged file (a truncated MCAP, an HDF5 file whose
         writer was killed) and list what was done in ``Recording.repairs``, instead of

@@ -34,15 +34,15 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
-from recordings.base import EVENTS_DTYPE, TABLE_SUFFIXES, register_format
+from recordings.base import EVENTS_DTYPE
 from recordings.csvio import DRIVE_TAG, EVENT_TAG, METADATA_TAG, drive_array
 from recordings.errors import CorruptRecordingError, MissingChannelError, one_line
 from recordings.recording import Recording
 from recordings.schema import COMMAND_DTYPE, DRIVE_DTYPE, GAUGES_DTYPE, RecordingMetadata
 
-__all__ = ["TABLE_SUFFIXES", "read_parquet", "write_table"]
+__all__ = ["read_parquet", "write_table"]
 
-#: Suffixes written by ``write_table`` (not streaming writers: ``labstand run`` refuses them).
+#: Each column's unit (in the CSV names; in the Parquet schema as field metadata).
 UNITS = {
     "t_s": "s",
     "t_ns": "ns",
@@ -203,6 +203,3 @@ def _parquet_streams(table: Any, where: str) -> tuple[NDArray[np.void], NDArray[
         command = np.empty(int(present.sum()), dtype=COMMAND_DTYPE)
         command["t_ns"], command["x_cmd_mm"] = gauges["t_ns"][present], x_cmd[present]
     return gauges, command
-
-
-register_format("Parquet", (".parquet",), reader=read_parquet)

@@ -33,7 +33,6 @@ from nptdms import TdmsFile, scaling
 from nptdms.types import DaqMxRawData
 from numpy.typing import NDArray
 
-from recordings.base import register_format
 from recordings.errors import (
     CorruptRecordingError,
     ImportMappingError,
@@ -297,6 +296,3 @@ def _read(
         start=_start(x_name, x_channel, where),
         repairs=repairs,
     )
-
-
-register_format("TDMS", (".tdms",), reader=read_tdms)

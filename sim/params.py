@@ -4,10 +4,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.interpolate import PchipInterpolator
+
+if TYPE_CHECKING:  # scipy.interpolate loads scipy.optimize (0.3 s): imported where used
+    from scipy.interpolate import PchipInterpolator
 
 FloatArray = NDArray[np.float64]
 
@@ -36,6 +39,8 @@ class FrictionTable:
 
     def pchip(self) -> PchipInterpolator:
         """The interpolant of μ over speed (within the table's range)."""
+        from scipy.interpolate import PchipInterpolator
+
         return PchipInterpolator(np.asarray(self.speed_m_s), np.asarray(self.mu))
 
     def mu_at(self, speed_m_s: FloatArray) -> FloatArray:

@@ -28,9 +28,9 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
 
 def writable_suffixes() -> list[str]:
     """Every suffix ``write_recording`` writes."""
-    from recordings.base import TABLE_SUFFIXES, formats
+    from recordings.formats import suffixes
 
-    return sorted({s for s, (_, writer, _) in formats().items() if writer} | set(TABLE_SUFFIXES))
+    return suffixes("write", "table")
 
 
 def check_target(target: Path, source: Path) -> None:

@@ -25,15 +25,15 @@ from labstand.targets import FILE, FOLDER
 
 if TYPE_CHECKING:  # imported where they run: `diagnose-check --help` loads no numba
     from drivers.signals import SignalSpec
+    from sim.checks.check import Case, CaseSpec
+    from sim.checks.check_other import PairCase
+    from sim.checks.otherstand.campaign import OtherRecording
     from sim.config import StandConfig
-    from sim.identify.check import Case, CaseSpec
-    from sim.identify.check_other import PairCase
-    from sim.otherstand.campaign import OtherRecording
 
-# Literal copies of sim.identify.check's TRUTHS and MASSES_KG, which imports numba: the
+# Literal copies of sim.checks.check's TRUTHS and MASSES_KG, which imports numba: the
 # parser is built without it (tests/core/test_cli_startup.py checks that they agree).
 TRUTHS = ("same", "other", "outside")
-#: The check's recording sets (``sim.identify.check.RECORDING_SETS``, not imported here:
+#: The check's recording sets (``sim.checks.check.RECORDING_SETS``, not imported here:
 #: ``--help`` loads no numba).
 RECORDING_SETS = ("moderate", "gentle", "brisk", "paper")
 MASSES_KG = (3.096, 8.131)
@@ -128,7 +128,7 @@ class CheckSetup:
 
 def check_job(setup: CheckSetup, spec: CaseSpec) -> tuple[Case | PairCase, dict[str, Any]]:
     """The job: one blind campaign, scored; its diagnosis as JSON (runs on a worker)."""
-    from sim.identify.check import diagnose_case
+    from sim.checks.check import diagnose_case
 
     case, diagnosis = diagnose_case(
         setup.stand, spec, setup.campaign, setup.truth_stand, setup.other_campaign
@@ -140,7 +140,7 @@ def run_cases(
     setup: CheckSetup, specs: Sequence[CaseSpec], options: ClusterOptions, progress: Progress
 ) -> list[JobResult[tuple[Case | PairCase, dict[str, Any]]]]:
     """Every campaign on the cluster (a single one here, unless a cluster was asked for)."""
-    from sim.identify.check import describe
+    from sim.checks.check import describe
 
     job = functools.partial(check_job, setup)
     keys = [s.name for s in specs]
@@ -158,7 +158,7 @@ def run_cases(
 
 def _classes(args: argparse.Namespace) -> list[str]:
     """The classes asked for (CommandError, exit 2, for an unknown one)."""
-    from sim.identify.check import ARTEFACTS, CLASSES, OUTSIDE_CLASSES
+    from sim.checks.check import ARTEFACTS, CLASSES, OUTSIDE_CLASSES
 
     known = OUTSIDE_CLASSES if args.truth == "outside" else [*CLASSES, ARTEFACTS]
     if args.effects is None:
@@ -174,7 +174,7 @@ def _classes(args: argparse.Namespace) -> list[str]:
 
 def _pairs(args: argparse.Namespace) -> list[tuple[str, ...]]:
     """The two- and three-effect campaigns asked for (CommandError, exit 2, if malformed)."""
-    from sim.otherstand import OTHER_EFFECTS, OTHER_PAIRS, OTHER_TRIPLES
+    from sim.checks.otherstand import OTHER_EFFECTS, OTHER_PAIRS, OTHER_TRIPLES
 
     chosen: list[tuple[str, ...]] = []
     for flag, given, size, standard in (
@@ -216,8 +216,8 @@ def _recording_set(args: argparse.Namespace) -> str:
 def run(args: argparse.Namespace) -> int:
     """Run the check and report."""
     from labstand.campaign_table import campaign_row, write_results
-    from sim.identify.check import CLASSES, SMALL_CAMPAIGN, check_cases, recording_set, score
-    from sim.otherstand.campaign import OTHER_SMALL
+    from sim.checks.check import CLASSES, SMALL_CAMPAIGN, check_cases, recording_set, score
+    from sim.checks.otherstand.campaign import OTHER_SMALL
 
     stand = load_stand(args)
     classes = _classes(args)

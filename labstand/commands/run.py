@@ -150,7 +150,7 @@ class _Plan:
 
 def _check(args: argparse.Namespace) -> _Plan:
     """Every check that needs no device: usage (2) and refusals (3)."""
-    from recordings.base import formats
+    from recordings.formats import suffixes
 
     config = load_stand(args)
     spec, mass = signal_from_args(args, config)
@@ -179,9 +179,7 @@ def _check(args: argparse.Namespace) -> _Plan:
     )
     plan_motion(spec, config.drive)  # LimitError: refused before anything is touched
     suffix = args.output.suffix.lower()
-    known = formats()
-    if suffix not in known or known[suffix][1] is None:
-        writable = sorted(s for s, f in known.items() if f[1] is not None)
+    if suffix not in (writable := suffixes("write")):
         raise CommandError(
             f"{args.output}: cannot record {suffix or 'without a suffix'!r}; use one of "
             f"{', '.join(writable)}",

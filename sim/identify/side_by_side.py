@@ -13,7 +13,6 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor
-from functools import cache
 from typing import TypeVar
 
 import numba
@@ -23,22 +22,19 @@ T = TypeVar("T")
 __all__ = ["side_by_side"]
 
 
-@cache
-def _pool(threads: int) -> ThreadPoolExecutor:
-    return ThreadPoolExecutor(max_workers=threads, thread_name_prefix="trace")
-
-
 def side_by_side(work: Callable[[int, bool], T], sizes: Sequence[int]) -> list[T]:
     """``work(k, serial)`` for every item k (``sizes[k]``: its cost), results in order.
 
     With more than one numba thread and more than one item, the items run in threads
     (largest first) with ``serial`` True; otherwise one after the other with ``serial``
-    False (on all cores each).
+    False (on all cores each). The threads live for this call only (started and joined
+    here: no pool outlives it, so no state is shared between calls); that costs about
+    0.5 ms a call against some 20 ms of work (docs/benchmarks.md).
     """
     threads = min(len(sizes), numba.get_num_threads())
     if threads < 2:
         return [work(k, False) for k in range(len(sizes))]
-    pool = _pool(threads)
     order = sorted(range(len(sizes)), key=lambda k: -sizes[k])
-    futures = {k: pool.submit(work, k, True) for k in order}
-    return [futures[k].result() for k in range(len(sizes))]
+    with ThreadPoolExecutor(max_workers=threads, thread_name_prefix="trace") as pool:
+        futures = {k: pool.submit(work, k, True) for k in order}
+        return [futures[k].result() for k in range(len(sizes))]

@@ -92,7 +92,7 @@ def test_a_mistyped_command_is_refused_in_one_line(capsys: pytest.CaptureFixture
 
 def test_literal_copies_for_the_parser_agree_with_their_sources() -> None:
     from labstand.commands import diagnose_check
-    from sim.identify.check import MASSES_KG, RECORDING_SETS, TRUTHS
+    from sim.checks.check import MASSES_KG, RECORDING_SETS, TRUTHS
 
     assert diagnose_check.TRUTHS == TRUTHS and diagnose_check.MASSES_KG == MASSES_KG
     assert diagnose_check.RECORDING_SETS == RECORDING_SETS

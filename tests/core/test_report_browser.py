@@ -22,9 +22,9 @@ import pytest
 
 from labstand.diagnosis_report import write_report
 from labstand.provenance import BUILT_IN_STAND, RecordingSource, build_provenance
+from sim.checks.check import SMALL_CAMPAIGN, make_campaign
 from sim.config import StandConfig
 from sim.identify import Diagnosis, Trace
-from sim.identify.check import SMALL_CAMPAIGN, make_campaign
 from sim.identify.heldout import Outputs, channel_gap, heldout_error, noise_floor
 from sim.identify.remainder import VERDICT_WORDS
 from sim.identify.report import AcceptedEffect, RankedEffect

@@ -11,12 +11,12 @@ import numpy as np
 import pytest
 
 from drivers.signals import Shape, SignalSpec, plan_motion
+from sim.checks.check import DRIVE_NOISE_M, SMALL_CAMPAIGN
 from sim.config import StandConfig
 from sim.effects import EFFECTS, EffectError, EffectSpec, parse_effect, register, unregister
 from sim.effects.info import EffectInfo
 from sim.effects.realism import MeasurementNoise, NoiseSpec, draw_real_stand
 from sim.identify import diagnose, make_trace
-from sim.identify.check import DRIVE_NOISE_M, SMALL_CAMPAIGN
 from sim.model import Model
 from tests.effects import weight_viscous_damping
 

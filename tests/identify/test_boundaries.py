@@ -12,7 +12,7 @@ FORBIDDEN = ("pymodbus", "serial", "sim.hardware", "h5py", "mcap", "nptdms", "re
 def test_the_fitter_and_the_diagnosis_load_no_modbus_server_and_no_file_format() -> None:
     code = (
         "import json, sys\n"
-        "import sim.identify, sim.identify.check, sim.identify.fitting\n"
+        "import sim.identify, sim.checks.check, sim.identify.fitting\n"
         f"bad = [m for m in sys.modules if m.split('.')[0] in {FORBIDDEN!r} "
         f"or m.startswith({FORBIDDEN!r})]\n"
         "print(json.dumps(sorted(bad)))\n"

@@ -8,11 +8,11 @@ import numpy as np
 import pytest
 
 from drivers.signals import plan_motion
+from sim.checks.check import DRIVE_NOISE_M, SMALL_CAMPAIGN
 from sim.config import StandConfig
 from sim.effects import EffectSpec
 from sim.effects.realism import MeasurementNoise, NoiseSpec, draw_real_stand
 from sim.identify import diagnose, make_trace
-from sim.identify.check import DRIVE_NOISE_M, SMALL_CAMPAIGN
 from sim.identify.decide import Evidence, family_p_values, p_value_of_gains
 from sim.identify.fitting import FreeParam
 from sim.identify.naming import SECOND_STAGE, beats, second_tries, strongest_accepted

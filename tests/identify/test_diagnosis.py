@@ -12,9 +12,9 @@ import pytest
 
 from labstand.campaigns import trace_of
 from labstand.cli import main
+from sim.checks.check import SMALL_CAMPAIGN, Case, CheckResult, make_campaign, run_check
 from sim.config import StandConfig
 from sim.identify import DiagnosisInputError, diagnose
-from sim.identify.check import SMALL_CAMPAIGN, Case, CheckResult, make_campaign, run_check
 from sim.identify.traces import PHASE_FALL, PHASE_HOLD, PHASE_REST, PHASE_RISE
 
 

@@ -7,8 +7,8 @@ import dataclasses
 import numpy as np
 import pytest
 
+from sim.checks.check import CaseSpec, make_campaign
 from sim.config import default_config
-from sim.identify.check import CaseSpec, make_campaign
 from sim.identify.fitting import Candidate, Objective, effect_grid_start, fit
 from sim.identify.refitting import REFIT_FTOL
 from sim.identify.shooting import dial_slope

@@ -7,8 +7,8 @@ import dataclasses
 import numpy as np
 import pytest
 
+from sim.checks.check import SMALL_CAMPAIGN, CaseSpec, make_campaign
 from sim.config import default_config
-from sim.identify.check import SMALL_CAMPAIGN, CaseSpec, make_campaign
 from sim.identify.fitting import Candidate, fit, grid_axis
 from sim.identify.refitting import refine_form, refit
 from sim.identify.shooting import dial_slope

@@ -7,8 +7,8 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from sim.checks.check import SMALL_CAMPAIGN, make_campaign
 from sim.config import StandConfig
-from sim.identify.check import SMALL_CAMPAIGN, make_campaign
 from sim.identify.heldout import (
     Outputs,
     bootstrap_confidence,

@@ -9,11 +9,11 @@ import pytest
 from scipy import stats
 
 from drivers.signals import plan_motion
+from sim.checks.check import CaseSpec, covered_truth, make_campaign, recording_set
 from sim.config import StandConfig
 from sim.effects import EffectSpec
 from sim.effects.realism import MeasurementNoise, NoiseSpec
 from sim.identify import diagnose, make_trace
-from sim.identify.check import CaseSpec, covered_truth, make_campaign, recording_set
 from sim.identify.fitting import Candidate
 from sim.identify.heldout import Outputs, channel_gap
 from sim.identify.intervals import (

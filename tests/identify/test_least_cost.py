@@ -7,8 +7,8 @@ import dataclasses
 import numpy as np
 import pytest
 
+from sim.checks.check import CaseSpec, make_campaign
 from sim.config import default_config
-from sim.identify.check import CaseSpec, make_campaign
 from sim.identify.fitting import Candidate, Objective, effect_grid_start, fit, grid_axis
 from sim.identify.least_cost import FloatArray, TraceCost, least_cost_point
 from sim.identify.shooting import dial_slope

@@ -10,15 +10,15 @@ import pytest
 from scipy.signal import lfilter
 
 from labstand.diagnosis_report import write_report
+from sim.checks.check import CaseSpec, make_campaign, recording_set
+from sim.checks.otherstand.campaign import make_other_campaign
+from sim.checks.otherstand.gauges import Realism
+from sim.checks.otherstand.outside import force_drift
 from sim.config import StandConfig
 from sim.identify import diagnose, make_trace
-from sim.identify.check import CaseSpec, make_campaign, recording_set
 from sim.identify.remainder import judge_signatures, verdict
 from sim.identify.signature import _taut_filters, stlsq
 from sim.identify.traces import Trace
-from sim.otherstand.campaign import make_other_campaign
-from sim.otherstand.gauges import Realism
-from sim.otherstand.outside import force_drift
 
 LIGHT, HEAVY = 3.096, 8.131
 #: Candidates for the short diagnoses here: two gauges that a drifting or curved reading

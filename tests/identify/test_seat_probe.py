@@ -77,11 +77,11 @@ def test_seat_steps_are_read_again_with_the_refits_own_baseline(stand: StandConf
     # read and tried there cost more than a two-groove toggle, and the refit ended in
     # that basin (step −2.3 mm) with k and c near the truth. Read again there, the
     # steps give the ratchet: a far better fit, the truth's step and seats.
-    from sim.identify.check import CaseSpec, make_campaign
+    from sim.checks.check import CaseSpec, make_campaign
+    from sim.checks.otherstand.campaign import OTHER_SETS
     from sim.identify.fitting import Candidate, effect_grid_start, fit
     from sim.identify.refitting import read_again, short_fit
     from sim.identify.shooting import dial_slope
-    from sim.otherstand.campaign import OTHER_SETS
 
     spec = CaseSpec(EFFECT, 3.096, 0, 1)
     traces, _, truth = make_campaign(

@@ -126,7 +126,7 @@ def test_restarts_take_the_displacement_on_the_dial_gauges_own_scale(
 ) -> None:
     # The gauge reads 3 % high; the recordings show it (u against the drive at constant
     # force, calm samples of all traces), so every candidate restarts from the true u.
-    from sim.identify.check import SMALL_CAMPAIGN, make_campaign
+    from sim.checks.check import SMALL_CAMPAIGN, make_campaign
 
     rng = np.random.default_rng(7)
     traces, _, params = make_campaign(stand, "dial_gauge_calibration", mass, rng, SMALL_CAMPAIGN)

@@ -18,9 +18,9 @@ from numpy.typing import NDArray
 
 from drivers.limits import DriveLimits
 from drivers.signals import Shape, SignalSpec, plan_motion
-from sim.otherstand.gauges import Realism
-from sim.otherstand.outside import ALL_EFFECTS
-from sim.otherstand.stand import simulate
+from sim.checks.otherstand.gauges import Realism
+from sim.checks.otherstand.outside import ALL_EFFECTS
+from sim.checks.otherstand.stand import simulate
 from sim.params import StandParams
 
 FloatArray = NDArray[np.float64]

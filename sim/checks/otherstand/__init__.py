@@ -8,7 +8,7 @@ integrator (``_kernel``), its own equations and ranges (``effects``), its own ga
 noise (``gauges``), its own drive signals and campaigns (``campaign``).
 """
 
-from sim.otherstand.effects import OTHER_EFFECTS, OTHER_PAIRS, OTHER_TRIPLES, OtherEffect
-from sim.otherstand.stand import OtherRun, simulate
+from sim.checks.otherstand.effects import OTHER_EFFECTS, OTHER_PAIRS, OTHER_TRIPLES, OtherEffect
+from sim.checks.otherstand.stand import OtherRun, simulate
 
 __all__ = ["OTHER_EFFECTS", "OTHER_PAIRS", "OTHER_TRIPLES", "OtherEffect", "OtherRun", "simulate"]

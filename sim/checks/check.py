@@ -12,7 +12,7 @@ either truth). The diagnosis sees only the recordings (as DataFrames, like files
 back) and the nominal stand.
 
 ``truth_stand``: ``"same"`` draws the truth from the candidate models themselves (as
-above); ``"other"`` from ``sim.otherstand``, an independently written stand with a second
+above); ``"other"`` from ``sim.checks.otherstand``, an independently written stand with a second
 formulation of every effect, its own ranges, four other drive signals and the validation
 set's noise levels. ``pairs`` (other truth only) adds campaigns with two effects at once.
 """
@@ -30,10 +30,12 @@ from typing import Any
 import numpy as np
 
 from drivers.signals import Shape, SignalSpec, plan_motion
+from sim.checks.check_other import PairCase, named_effects, other_campaign_traces, pairs_summary
+from sim.checks.otherstand.campaign import OTHER_FULL, OTHER_SETS, OtherRecording
+from sim.checks.otherstand.outside import OUTSIDE_EFFECTS, SIGNATURE_KIND
 from sim.config import StandConfig
 from sim.effects import EFFECTS, EffectSpec
 from sim.effects.realism import MeasurementNoise, NoiseSpec, draw_real_stand
-from sim.identify.check_other import PairCase, named_effects, other_campaign_traces, pairs_summary
 from sim.identify.decide import compare
 from sim.identify.fitting import Candidate, simulate_values
 from sim.identify.heldout import Outputs, heldout_error
@@ -42,15 +44,13 @@ from sim.identify.report import Diagnosis
 from sim.identify.shooting import dial_slope
 from sim.identify.traces import Trace, make_trace
 from sim.model import Model
-from sim.otherstand.campaign import OTHER_FULL, OTHER_SETS, OtherRecording
-from sim.otherstand.outside import OUTSIDE_EFFECTS, SIGNATURE_KIND
 from sim.params import StandParams
 
 log = logging.getLogger(__name__)
 
 CLASSES = ["none", *EFFECTS]
 #: Where a check's truth comes from: the candidates' own code, the other stand, or the
-#: other stand with effects outside the catalogue (``sim.otherstand.outside``).
+#: other stand with effects outside the catalogue (``sim.checks.otherstand.outside``).
 TRUTHS = ("same", "other", "outside")
 #: A ``none`` campaign whose recorder adds artefacts (``Realism.with_artefacts``).
 ARTEFACTS = "artefacts"
@@ -77,7 +77,7 @@ SMALL_CAMPAIGN = (
 
 
 #: A campaign's recordings: (name, signal) under the stand's drive limits, or the other
-#: stand's recordings (signal and limits each; ``sim.otherstand.campaign.OTHER_SETS``).
+#: stand's recordings (signal and limits each; ``sim.checks.otherstand.campaign.OTHER_SETS``).
 CampaignSpec = Sequence[tuple[str, SignalSpec] | OtherRecording]
 #: The recording sets a check can draw its campaigns with (``recording_set``): the other
 #: stand's (the validation campaigns' four drive signals are ``moderate``), and the

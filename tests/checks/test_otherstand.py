@@ -1,4 +1,4 @@
-"""The other truth stand (sim/otherstand): physics, effects' limits, independence, wiring."""
+"""The other truth stand (sim/checks/otherstand): physics, effects' limits, independence, wiring."""
 
 from __future__ import annotations
 
@@ -15,13 +15,13 @@ from scipy.signal import butter, sosfiltfilt
 from drivers.limits import DriveLimits
 from drivers.signals import Shape, SignalSpec, plan_motion
 from labstand.cli import main
+from sim.checks.check import FULL_CAMPAIGN, make_campaign, recording_set
+from sim.checks.otherstand import OTHER_EFFECTS, OTHER_PAIRS, simulate
+from sim.checks.otherstand import _kernel as kern
+from sim.checks.otherstand.campaign import OTHER_SETS, OTHER_SMALL, make_other_campaign
+from sim.checks.otherstand.gauges import sample_delayed
+from sim.checks.otherstand.stand import parameter_row
 from sim.config import StandConfig
-from sim.identify.check import FULL_CAMPAIGN, make_campaign, recording_set
-from sim.otherstand import OTHER_EFFECTS, OTHER_PAIRS, simulate
-from sim.otherstand import _kernel as kern
-from sim.otherstand.campaign import OTHER_SETS, OTHER_SMALL, make_other_campaign
-from sim.otherstand.gauges import sample_delayed
-from sim.otherstand.stand import parameter_row
 from sim.params import StandParams
 
 RATE = 2000.0
@@ -266,19 +266,19 @@ def test_the_package_imports_none_of_the_candidate_code() -> None:
 
     sim_dir = Path(sim.params.__file__).parent
     # sim/__init__ re-exports the model, so the package is stubbed: what is imported is
-    # what sim.otherstand itself pulls in.
+    # what sim.checks.otherstand itself pulls in.
     code = (
         "import sys, importlib.util as iu, numpy as np\n"
         f"spec = iu.spec_from_file_location('sim', {str(sim_dir / '__init__.py')!r},\n"
         f"    submodule_search_locations=[{str(sim_dir)!r}])\n"
         "sys.modules['sim'] = iu.module_from_spec(spec)  # not executed\n"
         "from sim.config import default_config\n"
-        "import sim.otherstand, sim.otherstand.campaign\n"
+        "import sim.checks.otherstand, sim.checks.otherstand.campaign\n"
         "st = default_config().stand_params('final', 3.096)\n"
-        "sim.otherstand.simulate(st, {'fibre_viscoelastic': {}}, np.zeros(50), 2000.0)\n"
+        "sim.checks.otherstand.simulate(st, {'fibre_viscoelastic': {}}, np.zeros(50), 2000.0)\n"
         "bad = ('sim.effects', 'sim.model', 'sim.kernel', 'sim._baseline', 'sim.identify')\n"
         "print(sorted(m for m in sys.modules if m.startswith(bad)))\n"
-        "print('sim.otherstand.stand' in sys.modules)\n"
+        "print('sim.checks.otherstand.stand' in sys.modules)\n"
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True, timeout=120)  # fmt: skip

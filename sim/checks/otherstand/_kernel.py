@@ -10,7 +10,7 @@ Karnopp friction laws are left to the fine step (their band keeps them continuou
 State vector (``N_STATE``): u, v (weight), s, w (pulley rim), q (Maxwell branches, two per
 fibre segment), p (seat length change), a and ȧ (three string modes of each free span),
 z and ż (the drive anchor, for the out-of-catalogue terms).
-Parameter row: the ``P_*`` indices below, filled by ``sim.otherstand.stand``.
+Parameter row: the ``P_*`` indices below, filled by ``sim.checks.otherstand.stand``.
 """
 
 from __future__ import annotations
@@ -27,7 +27,7 @@ from numba import njit
  P_SS_ON, P_RATIO, P_VS, P_EXP, P_SL_ON, P_MUW, P_SINB, P_PEXP, P_TSTICK, P_VBAND,
  P_HARD, P_WAVE_A, P_WAVE_K, P_WAVE_PH, P_VISC, P_QDRAG, P_FR_ON, P_FR_W, P_FR_Z, P_FR_M,
  N_PARAM) = range(58)  # fmt: skip
-# P_HARD … P_FR_M: the out-of-catalogue terms (``sim.otherstand.outside``): the fibre's
+# P_HARD … P_FR_M: the out-of-catalogue terms (``sim.checks.otherstand.outside``): the fibre's
 # strain stiffening, a force along a wavy guide, viscous and quadratic drag on the
 # weight, and a compliant drive anchor (a mode of its own, frequency, damping, mass).
 

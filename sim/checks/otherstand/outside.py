@@ -29,8 +29,8 @@ from collections.abc import Mapping
 import numpy as np
 from numpy.typing import NDArray
 
-from sim.otherstand import _kernel as kern
-from sim.otherstand.effects import OTHER_EFFECTS, OtherEffect, Params, _log_uniform, _sign
+from sim.checks.otherstand import _kernel as kern
+from sim.checks.otherstand.effects import OTHER_EFFECTS, OtherEffect, Params, _log_uniform, _sign
 from sim.params import StandParams
 
 FloatArray = NDArray[np.float64]

@@ -17,9 +17,9 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from sim.otherstand import _kernel as kern
-from sim.otherstand.gauges import record
-from sim.otherstand.outside import ALL_EFFECTS, check_effects, fill_outside
+from sim.checks.otherstand import _kernel as kern
+from sim.checks.otherstand.gauges import record
+from sim.checks.otherstand.outside import ALL_EFFECTS, check_effects, fill_outside
 from sim.params import StandParams
 
 FloatArray = NDArray[np.float64]

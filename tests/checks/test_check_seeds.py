@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from sim.identify.check import CaseSpec, check_cases
+from sim.checks.check import CaseSpec, check_cases
 
 
 def test_a_campaign_draws_the_same_whatever_else_the_check_holds() -> None:

@@ -1,4 +1,4 @@
-"""The check's other truth: campaigns of ``sim.otherstand`` as traces, and two-effect scores.
+"""The check's other truth: campaigns of ``sim.checks.otherstand`` as traces, and two-effect scores.
 
 Kept apart from ``check`` so the other truth stays an add-on to it (see ``check``).
 """
@@ -11,12 +11,12 @@ from typing import Any
 
 import numpy as np
 
+from sim.checks.otherstand.campaign import OtherRecording, make_other_campaign
+from sim.checks.otherstand.gauges import Realism
 from sim.config import StandConfig
 from sim.identify.heldout import Outputs
 from sim.identify.report import Diagnosis
 from sim.identify.traces import Trace, make_trace
-from sim.otherstand.campaign import OtherRecording, make_other_campaign
-from sim.otherstand.gauges import Realism
 
 __all__ = ["PairCase", "named_effects", "other_campaign_traces", "pairs_summary"]
 

@@ -17,7 +17,7 @@ from numba import njit
 from numpy.typing import NDArray
 from scipy.signal import cont2discrete, lfilter, lfilter_zi
 
-from sim.otherstand.outside import force_drift
+from sim.checks.otherstand.outside import force_drift
 
 FloatArray = NDArray[np.float64]
 
