@@ -228,17 +228,21 @@ def trend_summary(cases: Sequence[Case]) -> dict[str, dict[str, float]]:
     }
 
 
-def covered_truth(d: Diagnosis, truth: dict[str, float]) -> dict[str, bool]:
-    """Whether each interval the diagnosis gives holds the true value (where it is known)."""
+def covered_truth(d: Diagnosis, effect: str, truth: dict[str, float]) -> dict[str, bool]:
+    """Whether each interval the diagnosis gives holds the true value (where it is known).
+
+    ``truth``: a same-form campaign's parameters (``make_campaign``): the baseline's
+    multipliers and the true ``effect``'s own parameters. Keys: the baseline's names and
+    ``effect.param``.
+    """
     held = {}
     for name, (lo, hi) in d.baseline_intervals.items():
         if name in truth:
             held[name] = bool(lo <= truth[name] <= hi)
     for a in d.effects:
         for name, (lo, hi) in a.intervals.items():
-            key = f"{a.effect}.{name}"
-            if key in truth and lo < hi:  # a held count or threshold has no interval
-                held[key] = bool(lo <= truth[key] <= hi)
+            if a.effect == effect and name in truth and lo < hi:  # a held count has none
+                held[f"{effect}.{name}"] = bool(lo <= truth[name] <= hi)
     return held
 
 
@@ -277,7 +281,7 @@ def make_campaign(
     if truth != "none":
         spec = EffectSpec(truth, EFFECTS[truth].draw(rng))
         effects = [spec]
-        params.update({f"{truth}.{k}": v for k, v in spec.resolved().items()})
+        params.update(spec.resolved())
     noise = NoiseSpec.draw(rng)
     traces, oracle = [], []
     for item in campaign:
@@ -419,7 +423,7 @@ def diagnose_case(
     case = Case(
         spec.truth, spec.mass_kg, d.effect, params, shrink, oracle_shrink, seconds, identifiable,
         d.verdict, named_effects(d), kinds,
-        covered_truth(d, params) if truth_stand == "same" else {}, trends,
+        covered_truth(d, spec.truth, params) if truth_stand == "same" else {}, trends,
     )  # fmt: skip
     return case, d
 

@@ -160,7 +160,7 @@ def test_a_diagnosis_reports_intervals_that_hold_its_numbers(stand: StandConfig)
     # Every recording fitted alone, with its drive, and a consistency entry per parameter.
     assert set(d.per_recording) == {t.name for t in traces}
     assert set(d.consistency) >= {"stiffness_scale", "fibre_viscoelastic.relaxation_time_s"}
-    held = covered_truth(d, truth)
+    held = covered_truth(d, spec.truth, truth)
     assert set(held) >= {"stiffness_scale", "fibre_viscoelastic.relaxation_time_s"}
     payload = d.to_dict()
     assert payload["effects"][0]["intervals"]["relaxation_time_s"] == list(
