@@ -2,19 +2,17 @@
 
 The gap is measured on held-out cycles, in noise units. The stages, in order:
 
-1. **Baseline** (``_baseline``): fit the baseline's stiffness, damping and friction scale
-   (``fitting``).
+1. **Baseline** (``_baseline``): the stiffness, damping and friction scale (``fitting``).
 2. **Screen** (``_screen``): a score test of every candidate effect (``screening``) orders
    them and gives each refit a start point.
 3. **Refit** (``_refit_all``): every candidate (baseline parameters and the effect's
    together, from the best point of a grid over the effect's physical range, with points
    the recordings show directly) on the training cycles; the leader's form too.
-4. **Judge** (``_best_baseline``, ``_first_effect``): the baseline gets the same chance
+4. **Judge** (``_best_baseline``, ``_name_effects``): the baseline gets the same chance
    (each candidate's baseline parameters alone); each candidate is judged against it on
-   the held-out cycles (``decide``): the best closure among those whose gain is
-   evidence at the family-wise rate ``ALPHA`` is named, unless a signature of the
-   remainder beats it (``naming.signature_rival``). Candidates that do about as well
-   are named beside it.
+   held-out cycles (``decide``): the best closure whose gain is evidence at the
+   family-wise rate ``ALPHA`` is named, unless a signature of the remainder beats it
+   (``naming.signature_rival``); those that do about as well are named beside it.
 5. **Further effects** (``_further_effects``): on top of those named, the next best
    candidates are refitted with them and judged against them the same way, up to
    ``MAX_EFFECTS``, each also against the richer forms of those named.
@@ -47,7 +45,13 @@ from sim.identify.heldout import (
     heldout_excess,
     noise_floor,
 )
-from sim.identify.intervals import GAP_METHOD, PARAMETER_METHOD, gap_intervals, parameter_intervals
+from sim.identify.intervals import (
+    BIAS_REPLICATES,
+    GAP_METHOD,
+    PARAMETER_METHOD,
+    gap_intervals,
+    parameter_intervals,
+)
 from sim.identify.naming import (
     MAX_EFFECTS,
     further_effect,
@@ -347,11 +351,12 @@ def how_sure(
 ) -> dict[str, Any]:
     """Stage 6: intervals of the final model's parameters and the gap; per-recording fits.
 
-    The named effects' parameters are reported as the final model (all of them together)
-    has them. Returns the Diagnosis fields.
+    The named effects' parameters are as the final model (all together) has them.
     """
     traces, nominal = run.traces, run.nominal
-    sure = parameter_intervals(final.candidate, final.values, traces, nominal)
+    sure = parameter_intervals(
+        final.candidate, final.values, traces, nominal, replicates=BIAS_REPLICATES
+    )
     for a in accepted:
         prefix = f"{a.effect}."
         a.params = effect_params(a.effect, final.values)
