@@ -263,8 +263,8 @@ def _name_effects(
 ) -> tuple[list[AcceptedEffect], dict[str, str], Fitted, float]:
     """Stages 4b and 5: the first effect, then further ones on top.
 
-    Returns the named effects, those displaced by a signature (effect → its kind), the
-    final model's fit (meaningful where an effect is named) and the bootstrap confidence.
+    Returns the named effects, those displaced (effect → signature kind), the final
+    model's fit (where an effect is named) and the bootstrap confidence.
     """
     refits, evidence, traces = judged.refits, judged.evidence, run.traces
     displaced: dict[str, str] = {}
@@ -311,9 +311,8 @@ def _further_effects(
 ) -> tuple[list[AcceptedEffect], Fitted]:
     """Stage 5: further effects, one at a time on top of those named (``MAX_EFFECTS``).
 
-    Each is judged against the model before it and against a signature of its
-    remainder; one that does no better than a richer form of those named is set aside
-    (``displaced``) and the others are tried.
+    Each is judged against the model before it and a signature of its remainder; one no
+    better than a richer form of those named is set aside (``displaced``).
     """
     trained = {e: f.result.train_cost for e, f in judged.refits.items()}
     alone = {e: own_values(e, f.result.values) for e, f in judged.refits.items()}
