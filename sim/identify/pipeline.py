@@ -31,8 +31,6 @@ from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import Any
 
-import numpy as np
-
 from sim.effects import EFFECTS
 from sim.identify.decide import Evidence, judge
 from sim.identify.fitting import Candidate, FitResult, fit
@@ -382,10 +380,8 @@ def how_sure(
 
 
 def _states(traces: Sequence[Trace], outputs: Sequence[Outputs]) -> list[SimStates]:
-    """A model's states as the fit saw them (an open-loop run would attribute chaos)."""
     return [
-        SimStates(o.u_m, o.force_n, np.gradient(o.u_m, 1.0 / tr.rate_hz))
-        for tr, o in zip(traces, outputs, strict=True)
+        SimStates.of(o.u_m, o.force_n, tr.rate_hz) for tr, o in zip(traces, outputs, strict=True)
     ]
 
 

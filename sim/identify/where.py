@@ -34,6 +34,15 @@ class SimStates:
     force_n: FloatArray
     v_m_s: FloatArray
 
+    @classmethod
+    def of(cls, u_m: FloatArray, force_n: FloatArray, rate_hz: float) -> SimStates:
+        """A model's states from its outputs, u's rate by finite differences.
+
+        The outputs as the fit saw them (restarted from measured states): an open-loop run
+        of a chaotic light-weight recording would attribute chaos.
+        """
+        return cls(u_m, force_n, np.gradient(u_m, 1.0 / rate_hz))
+
 
 def regimes(states: SimStates, rate_hz: float) -> NDArray[np.int64]:
     """Regime index per sample (REGIMES order)."""
