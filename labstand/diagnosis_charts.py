@@ -151,39 +151,65 @@ def per_recording_plot(path: Path, result: Diagnosis) -> bool:
     return True
 
 
+#: The suffix of a per-recording panel that shows the baseline alone (no named effects).
+ALONE = " (baseline alone)"
+
+
+def _per_recording_series(result: Diagnosis) -> dict[str, tuple[str, str, dict[str, Any]]]:
+    """Panel name → (its part of a recording's fit, the parameter, its consistency test).
+
+    The final model's parameters (``params``), then the baseline alone's.
+    """
+    fits = result.per_recording
+    series: dict[str, tuple[str, str, dict[str, Any]]] = {}
+    for n in sorted({n for fit in fits.values() for n in fit.get("params", {})}):
+        series[n] = ("params", n, result.consistency.get(n) or {})
+    alone = sorted(
+        {n for f in fits.values() for n in f.get("baseline_alone", {}).get("params", {})}
+    )
+    for n in alone:
+        series[n + ALONE] = ("baseline_alone", n, result.baseline_consistency.get(n) or {})
+    return series
+
+
+def _fit_of(fit: dict[str, Any], where: str) -> dict[str, Any]:
+    return fit if where == "params" else fit.get("baseline_alone", {})
+
+
 def per_recording_figure(result: Diagnosis) -> Figure | None:
     """Each parameter fitted per recording against its drive rate, with its interval.
 
     None where the diagnosis has no per-recording fits. A parameter's panel title
-    carries the consistency test's p-value and the trend it names; recordings without a
-    stored drive rate are drawn side by side, numbered.
+    carries the consistency test's p-value and the trend it names; where effects are
+    named, the baseline alone's parameters follow (what the paper tuned per situation).
+    Recordings without a stored drive rate are drawn side by side, numbered.
     """
     fits = result.per_recording
-    names = sorted({n for fit in fits.values() for n in fit.get("params", {})})
-    if not names:
+    series = _per_recording_series(result)
+    if not series:
         return None
     plt = pyplot()
-    cols = min(3, len(names))
-    rows = math.ceil(len(names) / cols)
+    cols = min(3, len(series))
+    rows = math.ceil(len(series) / cols)
     fig, axes = plt.subplots(rows, cols, figsize=(3.9 * cols, 2.9 * rows), squeeze=False,
                              layout="constrained")  # fmt: skip
     recordings = list(fits)
     rates = [_number(fits[r].get("drive_rate_hz")) for r in recordings]
     by_rate = all(math.isfinite(x) for x in rates)
     xs = rates if by_rate else list(range(len(recordings)))
-    for ax, name in zip(axes.flat, names, strict=False):
+    for ax, (panel, (where, name, test)) in zip(axes.flat, series.items(), strict=False):
         for k, (rec, x) in enumerate(zip(recordings, xs, strict=True)):
-            value = _number(fits[rec].get("params", {}).get(name))
+            fit = _fit_of(fits[rec], where)
+            value = _number(fit.get("params", {}).get(name))
             if not math.isfinite(value):
                 continue
-            lo, hi = (_number(v) for v in fits[rec].get("intervals", {}).get(name, (value, value)))
+            lo, hi = (_number(v) for v in fit.get("intervals", {}).get(name, (value, value)))
             # no bar where the interval is missing or not finite (a point alone)
             below, above = (value - lo, hi - value) if math.isfinite(lo + hi) else (0.0, 0.0)
             err = [[max(below, 0.0)], [max(above, 0.0)]]
             ax.errorbar([x], [value], yerr=err, fmt="o", capsize=4,
                         color=_PALETTE[k % len(_PALETTE)], label=rec)  # fmt: skip
-        ax.set_title(_consistency_title(name, result.consistency.get(name)), fontsize=8,
-                     loc="left")  # fmt: skip
+        ax.set_title(_consistency_title(panel, test), fontsize=8, loc="left")
         ax.grid(alpha=0.3)
         ax.tick_params(labelsize=8)
         if by_rate:
@@ -191,7 +217,7 @@ def per_recording_figure(result: Diagnosis) -> Figure | None:
         else:
             ax.set_xticks(xs, [f"#{i + 1}" for i in xs])
             ax.set_xlabel("recording (no drive rate stored)", fontsize=8)
-    for ax in list(axes.flat)[len(names) :]:
+    for ax in list(axes.flat)[len(series) :]:
         ax.set_axis_off()
     handles, labels = axes[0, 0].get_legend_handles_labels()
     fig.legend(handles, labels, loc="outside upper center", ncol=min(len(labels), 4),

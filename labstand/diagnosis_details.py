@@ -88,16 +88,22 @@ def recording_section(result: Diagnosis, plotted: bool) -> str:
         )
         rows.append(
             f"<tr><td>{html.escape(rec)}</td><td>{number(fit.get('drive_rate_hz'))}</td>"
-            f"<td>{number(_mm(fit.get('amplitude_m')))}</td>"
+            f"<td>{number(_mm(fit.get('stroke_m', fit.get('amplitude_m'))))}</td>"
             f"<td>{number(fit.get('mass_kg'))}</td>{cells}</tr>"
         )
+    tests = [(n, t, "") for n, t in result.consistency.items()]
+    if result.effects:  # the baseline alone too: what the named effects took out
+        tests += [(n, t, " (baseline alone)") for n, t in result.baseline_consistency.items()]
     agree = "".join(
-        f"<tr><td><code>{html.escape(n)}</code></td><td>{number(t.get('p_value'), 2)}</td>"
-        f"<td>{html.escape(str(t.get('trend') or 'none found'))}</td></tr>"
-        for n, t in result.consistency.items()
+        f"<tr><td><code>{html.escape(n)}</code>{alone}</td>"
+        f"<td>{number(t.get('p_value'), 2)}</td>"
+        f"<td>{html.escape(str(t.get('trend') or 'none found'))}</td>"
+        f"<td>{html.escape(str(t.get('points_to') or ''))}</td></tr>"
+        for n, t, alone in tests
     )
     consistency = (
-        f"<table><tr><th>parameter</th><th>p (they agree)</th><th>trend</th></tr>{agree}</table>"
+        "<table><tr><th>parameter</th><th>p (they agree)</th><th>trend</th>"
+        f"<th>points to</th></tr>{agree}</table>"
         if agree
         else f"<p>Agreement across recordings: {NOT_COMPUTED}.</p>"
     )
@@ -108,9 +114,12 @@ def recording_section(result: Diagnosis, plotted: bool) -> str:
     )
     return f"""<h2 id="per-recording">Per recording</h2>
 <p>The parameters fitted to each recording alone, with their 95 % intervals, against the
-recording's drive rate; a small p says they differ between recordings.</p>
+recording's drive rate (its motion's rms frequency); a small p says they differ between
+recordings. Where effects are named, the baseline alone is fitted per recording too: the
+stiffness, damping and friction a hand-tuned model would need for each test, and whether
+the named effects explain why they differ.</p>
 {plot}
-<table><tr><th>recording</th><th>drive rate [Hz]</th><th>amplitude [mm]</th>
+<table><tr><th>recording</th><th>drive rate [Hz]</th><th>stroke [mm]</th>
 <th>mass [kg]</th>{head}</tr>{"".join(rows)}</table>
 {consistency}"""
 
