@@ -92,6 +92,30 @@ def test_parameters_per_recording_are_drawn_by_rate_or_side_by_side(tmp_path: Pa
     assert (tmp_path / "pr.png").read_bytes()[:4] == b"\x89PNG"
 
 
+def test_the_baseline_alone_per_recording_follows_the_final_model() -> None:
+    # The paper's question: the stiffness a baseline alone needs per test, and whether it
+    # moves with the rate, drawn after the final model's parameters with its own test.
+    result = _diagnosis([])
+    result.per_recording = {
+        name: {"params": {"k": 1.0}, "intervals": {"k": (0.9, 1.1)}, "drive_rate_hz": rate,
+               "baseline_alone": {"params": {"stiffness_scale": alone},
+                                  "intervals": {"stiffness_scale": (alone - 0.01, alone + 0.01)}}}
+        for name, rate, alone in (("quick", 2.0, 1.3), ("slow", 0.5, 1.1))
+    }  # fmt: skip
+    result.baseline_consistency = {"stiffness_scale": {"p_value": 1e-5, "trend": "rises"}}
+    fig = per_recording_figure(result)
+    assert fig is not None
+    try:
+        titles = [ax.get_title(loc="left") for ax in fig.axes if ax.lines]
+        assert titles[0].startswith("k") and "(baseline alone)" in titles[1]
+        assert "p = 1e-05" in titles[1] and "rises" in titles[1]
+        alone = fig.axes[1]
+        points = {tuple(line.get_xydata()[0]) for line in alone.lines if len(line.get_xdata()) == 1}
+        assert {(2.0, 1.3), (0.5, 1.1)} <= points
+    finally:
+        pyplot().close(fig)
+
+
 @pytest.mark.parametrize("name", ["x" * 80, "short"])
 def test_a_long_recording_name_is_shortened_in_titles(name: str) -> None:
     from labstand.diagnosis_plots import TITLE_NAME, short_name
