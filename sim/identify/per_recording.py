@@ -132,7 +132,12 @@ def consistency(candidate: Candidate, fits: Sequence[RecordingFit]) -> dict[str,
         q = float(np.sum(w * (theta - mean) ** 2))
         p = min(1.0, float(stats.chi2.sf(q, len(fits) - 1)) * len(names))
         entry: dict[str, Any] = {"p_value": p, "trend": None, "moves_with": None, "points_to": None}
-        if p < CONSISTENCY_ALPHA:
+        free = next(q for q in candidate.params if q.name == name)
+        if all(free.at_bound(f.values[name]) for f in fits):
+            # Pinned: agreement says nothing, but every recording wants more than the range.
+            entry["trend"] = f"{name} at the end of its range in every recording"
+            entry["points_to"] = "more than the model's range allows: an effect it lacks"
+        elif p < CONSISTENCY_ALPHA:
             entry.update(_trend(name, theta, w, fits))
         out[name] = entry
     return out

@@ -131,6 +131,11 @@ def test_consistency_flags_a_stiffness_that_rises_with_the_drive_rate() -> None:
              for f in rising]  # fmt: skip
     assert consistency(base, vague)["stiffness_scale"]["moves_with"] is None
     assert consistency(base, vague)["damping_scale"]["p_value"] == pytest.approx(1.0)
+    # Every recording at the range's end (a branch stiffer than the baseline may be):
+    # agreement means nothing there, and the answer says the range is too small.
+    pinned = [_fit(f.name, f.drive["drive_rate_hz"], 2.0, 0.01) for f in rising]
+    verdict = consistency(base, pinned)["stiffness_scale"]
+    assert verdict["moves_with"] is None and "end of its range" in verdict["trend"]
 
 
 def test_the_drive_rate_of_a_sine_is_its_frequency(stand: StandConfig) -> None:
