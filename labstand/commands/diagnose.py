@@ -147,6 +147,12 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
+def _with_interval(name: str, value: float, interval: tuple[float, float] | None) -> str:
+    """``name = value [low, high]`` (the 95 % interval where there is one)."""
+    shown = f"{name} = {value:.4g}"
+    return f"{shown} [{interval[0]:.4g}, {interval[1]:.4g}]" if interval else shown
+
+
 def _print_summary(result: Diagnosis, report: Path | None) -> None:
     from sim.identify.remainder import VERDICT_WORDS
 
@@ -162,8 +168,10 @@ def _print_summary(result: Diagnosis, report: Path | None) -> None:
             notes.append(
                 f"the recordings cannot tell it from {', '.join(e.indistinguishable_from)}"
             )
-        params = ", ".join(f"{k} = {v:.4g}" for k, v in e.params.items())
+        params = ", ".join(_with_interval(k, v, e.intervals.get(k)) for k, v in e.params.items())
         print(f"  {e.effect}: closes {e.closure:.0%} of the gap (p = {e.p_value:.2g}); {params}")
+        if e.reaches_bound:
+            notes.append(f"{', '.join(e.reaches_bound)}: the interval reaches the range's end")
         for note in notes:
             print(f"    {note}")
     for effect, kind in result.displaced.items():
@@ -177,6 +185,20 @@ def _print_summary(result: Diagnosis, report: Path | None) -> None:
         )
         for sig in [s for s in rem.signature if s.passes][:3]:
             print(f"  {sig.kind} in {sig.channel}: closes {sig.closes:.0%}; {sig.formula}")
+    base = ", ".join(
+        _with_interval(k, v, result.baseline_intervals.get(k)) for k, v in result.baseline.items()
+    )
+    print(f"Baseline (final model): {base}")
+    closure = result.gap_closure_interval
+    if closure is not None:
+        low, high = closure
+        print(f"Gap closed: {result.gap_closure:.0%} (95 % interval {low:.0%} to {high:.0%})")
+    alone = result.baseline_consistency if result.effects else {}
+    tests = [(t, " (baseline alone)") for t in alone.values()]
+    for test, which in [*tests, *((t, "") for t in result.consistency.values())]:
+        if test.get("trend"):
+            pointer = f": {test['points_to']}" if test.get("points_to") else ""
+            print(f"Per recording{which}: {test['trend']}{pointer}")
     print("Held-out gap        before            after")
     for ch in ("u", "F"):
         b, a = result.gap_before[ch], result.gap_after[ch]

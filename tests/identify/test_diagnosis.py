@@ -125,6 +125,13 @@ def test_diagnose_command_on_csv_recordings_with_report(
     # The named effect's evidence is its family p-value, what ALPHA judged.
     named = next(r for r in out["ranking"] if r["effect"] == out["effect"])
     assert out["effects"][0]["p_value"] == named["p_family"] <= 0.05
+    # How sure: the contract's intervals beside the numbers they bound.
+    assert set(out["baseline_intervals"]) == set(out["baseline_fit"])
+    low, high = out["effects"][0]["intervals"]["gain_error"]
+    assert low <= out["effects"][0]["params"]["gain_error"] <= high
+    low, high = out["gap_closure_interval"]
+    assert low <= out["gap_closure"] <= high
+    assert set(out["per_recording"]) == {Path(p).name for p in paths}
     page = (report / "index.html").read_text()
     assert "dial_gauge_calibration" in page and 'src="ranking.png"' in page
     # Provenance: the files by their hashes, the mass and where it came from, the stand;

@@ -9,6 +9,7 @@ import pytest
 from scipy import stats
 
 from drivers.signals import plan_motion
+from labstand.commands.diagnose import _print_summary
 from sim.checks.check import CaseSpec, covered_truth, make_campaign, recording_set
 from sim.config import StandConfig
 from sim.effects import EffectSpec
@@ -146,7 +147,9 @@ def test_the_drive_rate_of_a_sine_is_its_frequency(stand: StandConfig) -> None:
     assert drive_of(trace)["drive_rate_hz"] == pytest.approx(1.5, rel=0.02)
 
 
-def test_a_diagnosis_reports_intervals_that_hold_its_numbers(stand: StandConfig) -> None:
+def test_a_diagnosis_reports_intervals_that_hold_its_numbers(
+    stand: StandConfig, capsys: pytest.CaptureFixture[str]
+) -> None:
     recordings = recording_set("moderate", stand)[2:]
     spec = CaseSpec("fibre_viscoelastic", HEAVY, 0, 2)
     traces, _, truth = make_campaign(stand, spec.truth, HEAVY, spec.rng(), recordings)
@@ -167,6 +170,14 @@ def test_a_diagnosis_reports_intervals_that_hold_its_numbers(stand: StandConfig)
     assert set(d.consistency) >= {"stiffness_scale", "fibre_viscoelastic.relaxation_time_s"}
     held = covered_truth(d, spec.truth, truth)
     assert set(held) >= {"stiffness_scale", "fibre_viscoelastic.relaxation_time_s"}
+    # The CLI's summary shows each number with its interval.
+    _print_summary(d, None)
+    text = capsys.readouterr().out
+    lo, hi = d.baseline_intervals["stiffness_scale"]
+    assert f"stiffness_scale = {d.baseline['stiffness_scale']:.4g} [{lo:.4g}, {hi:.4g}]" in text
+    lo, hi = effect.intervals["relaxation_time_s"]
+    assert f"relaxation_time_s = {effect.params['relaxation_time_s']:.4g} [{lo:.4g}, " in text
+    assert "Gap closed: " in text and "95 % interval" in text
     payload = d.to_dict()
     assert payload["effects"][0]["intervals"]["relaxation_time_s"] == list(
         effect.intervals["relaxation_time_s"]
