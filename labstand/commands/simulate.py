@@ -21,14 +21,17 @@ from labstand.commands.common import (
     metadata_options,
 )
 from labstand.errors import CommandError, ExitCode
+from labstand.prediction import add_prediction_options, fitted_from_args
 from labstand.targets import FILE
 from sim.situations import SITUATIONS, situation
 
 if TYPE_CHECKING:
     from numpy.typing import NDArray
 
+    from labstand.prediction import Verdict
     from sim.config import StandConfig
     from sim.effects import EffectSpec
+    from sim.envelope import SlackRule
     from sim.params import StandParams
     from sim.results import SimResult
 
@@ -96,6 +99,7 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     parser.add_argument("-o", "--output", type=Path, help="write the run here (.csv, ...)")
     parser.add_argument("--plot", type=Path, metavar="PNG", help="plot x, u and F to a PNG")
     add_metadata_options(parser)
+    add_prediction_options(parser, override=False)
     parser.add_argument("--json", action="store_true", help="print a JSON summary")
     effects = parser.add_argument_group("unmodelled effects (docs/effects.md)")
     effects.add_argument(
@@ -141,6 +145,7 @@ def run(args: argparse.Namespace) -> int:
     params = config.stand_params(args.params, mass)
     _, x_m = profile.sample(config.sample_rate_hz)
     effects = parse_effects(args.effect or [])
+    verdict = _prediction(args, config, profile, mass)
     started = time.perf_counter()
     if effects or args.noise:
         result, truth = _simulate_real_like(x_m, config.sample_rate_hz, params, effects, args)
@@ -154,6 +159,12 @@ def run(args: argparse.Namespace) -> int:
     summary["params"] = args.params
     summary["situation"] = args.situation
     summary["wall_s"] = elapsed
+    summary["prediction"] = {
+        "admissible": verdict.admissible,
+        "breaches": verdict.breaches,
+        "model": verdict.model,
+        **verdict.prediction.to_dict(config.envelope, _slack_rule()),
+    }
     if args.output is not None:
         write_simulation(
             args.output,
@@ -176,6 +187,26 @@ def run(args: argparse.Namespace) -> int:
     else:
         _print_summary(summary)
     return 0
+
+
+def _slack_rule() -> SlackRule:
+    """The slack e-stop rule of a run at the default thresholds."""
+    from labstand.session.safety import SafetyLimits
+    from sim.envelope import SlackRule
+
+    limits = SafetyLimits()
+    return SlackRule(limits.slack_force_n, limits.slack_max_s)
+
+
+def _prediction(
+    args: argparse.Namespace, config: StandConfig, profile: DriveProfile, mass_kg: float
+) -> Verdict:
+    """What ``run`` would predict for this motion; a warning on stderr where it would refuse."""
+    from labstand.prediction import predict_profile, warn_simulated
+
+    verdict = predict_profile(config, profile, mass_kg, _slack_rule(), fitted_from_args(args))
+    warn_simulated(verdict)
+    return verdict
 
 
 def _simulate_real_like(
