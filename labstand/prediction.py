@@ -11,6 +11,7 @@ before the drive moves, unless the operator overrides the prediction.
 from __future__ import annotations
 
 import argparse
+import json
 import sys
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -60,11 +61,17 @@ def add_prediction_options(parser: argparse.ArgumentParser, override: bool) -> N
 
 
 def fitted_from_args(args: argparse.Namespace) -> FittedStand | None:
-    """The diagnosis named by --diagnosis, read and checked (exit 2 if unusable)."""
-    from labstand.fitted import read_diagnosis
+    """The model --diagnosis names, else the one a --plan was made with; exit 2 if unusable."""
+    from labstand.fitted import fitted_from_dict, read_diagnosis
 
     path = getattr(args, "diagnosis", None)
-    return None if path is None else read_diagnosis(path)
+    if path is not None:
+        return read_diagnosis(path)
+    plan = getattr(args, "plan", None)
+    if plan is None:
+        return None
+    model = json.loads(plan.read_text(encoding="utf-8")).get("diagnosis")  # signal_from_plan
+    return None if model is None else fitted_from_dict(model, plan)  # read it already
 
 
 @dataclass(frozen=True)

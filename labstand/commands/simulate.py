@@ -50,10 +50,22 @@ def add_signal_options(parser: argparse.ArgumentParser) -> None:
     group.add_argument("--dwell-start-s", type=float, help="rest before the motion, s (0.5)")
     group.add_argument("--dwell-end-s", type=float, help="rest after the motion, s (1.0)")
     group.add_argument("--mass-kg", type=float, help="weight mass, kg (default: the stand's)")
+    group.add_argument(
+        "--plan",
+        type=Path,
+        metavar="PLAN.json",
+        help="the motion and weight a `labstand plan -o PLAN.json` chose (no other signal "
+        "option beside it)",
+    )
 
 
 def signal_from_args(args: argparse.Namespace, config: StandConfig) -> tuple[SignalSpec, float]:
-    """The signal and weight mass the options ask for (a situation, then overrides)."""
+    """The signal and weight mass the options ask for (a plan, or a situation and overrides)."""
+    if args.plan is not None:
+        from labstand.planning import PLAN_OPTIONS, signal_from_plan
+
+        given = [f"--{o.replace('_', '-')}" for o in PLAN_OPTIONS if getattr(args, o) is not None]
+        return signal_from_plan(args.plan, given)
     overrides: dict[str, Any] = {}
     if args.amplitude_mm is not None:
         overrides["amplitude_m"] = args.amplitude_mm / 1e3
