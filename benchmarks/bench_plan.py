@@ -3,10 +3,11 @@
 The rivals of the diagnosis of a campaign with a 1.1 ms force-channel skew (named:
 force_gauge_dynamics, indistinguishable from channel_time_skew), the stand file's two
 weights, the whole grid. Ours: ``sim.planner.search`` (each chunk of 24 motions is one
-batch per rival and one for the prediction's 9 corners, on all cores). Reference, in the
-same run: the same judgements with one ``Model.run`` per motion and corner (and per
-rival on the admissible motions) on the grid's first 24 motions, scaled to the whole
-grid. Median of three runs each (a first run compiles; it is not counted).
+batch for the prediction's 9 corners and one per rival, its centre and a step of each of
+its parameters, on all cores). Reference, in the same run: the same judgements with one
+``Model.run`` per motion and corner (and per rival and parameter step on the admissible
+motions) on the grid's first 24 motions, scaled to the whole grid. Median of three runs
+each (a first run compiles; it is not counted).
 
 Run: ``.venv/bin/python benchmarks/bench_plan.py``.
 """
@@ -22,7 +23,16 @@ from sim.config import default_config
 from sim.effects import EffectSpec
 from sim.envelope import FITTED_SPREAD, Prediction, SlackRule, figures_of, worst_of
 from sim.model import Model
-from sim.planner import CHUNK, PREDICTABLE_SLACK, Noise, Rival, Setting, motion_grid, search
+from sim.planner import (
+    CHUNK,
+    PREDICTABLE_SLACK,
+    Noise,
+    Rival,
+    Setting,
+    motion_grid,
+    param_steps,
+    search,
+)
 
 GAUGE = EffectSpec("force_gauge_dynamics", {"cutoff_hz": 221.65, "damping_ratio": 0.715})
 SKEW = EffectSpec("channel_time_skew", {"force_skew_s": 0.0011})
@@ -62,7 +72,10 @@ def one_at_a_time(s: Setting, motions: list) -> None:  # type: ignore[type-arg]
         if worst.breaches(s.envelope, s.rule) or worst.worst.slack_share > PREDICTABLE_SLACK:
             continue
         for rival in s.rivals:
-            Model(stand, rival.effects).run(x, s.rate_hz)
+            model = Model(stand, rival.effects)
+            model.run(x, s.rate_hz)
+            for step in param_steps(rival):
+                model.variant(step).run(x, s.rate_hz)
 
 
 def main() -> None:

@@ -8,7 +8,8 @@ not the model that predicted) at three true stands drawn as ``diagnose-check`` d
 them (k ×0.8–1.25, c ×0.7–1.4, friction ×0.8–1.25), each with one of the other stand's
 physical effects drawn at random (or none), and checked against the limits: the slack
 e-stop (recorded F < 2 N for > 0.25 s), the weight's travel and the fibre's safe peak
-tension. Prints the counts and every violation.
+tension. Prints the counts and every violation, and which of them the planner could plan
+(its set: within ``PLAN_MARGIN`` of every limit, slack at most ``PREDICTABLE_SLACK``).
 
 Run: ``.venv/bin/python benchmarks/plan_safety.py [--draws N]``.
 """
@@ -24,7 +25,7 @@ from sim.config import default_config
 from sim.envelope import NOMINAL_SPREAD, SlackRule, figures_of
 from sim.otherstand import OTHER_EFFECTS, simulate
 from sim.otherstand.campaign import draw_true_stand
-from sim.planner import PREDICTABLE_SLACK, motion_grid
+from sim.planner import PLAN_MARGIN, PREDICTABLE_SLACK, motion_grid
 from sim.prediction import predict
 
 RULE = SlackRule(2.0, 0.25)
@@ -38,7 +39,7 @@ def main() -> None:
     rate = config.sample_rate_hz
     physical = [n for n, e in OTHER_EFFECTS.items() if e.kind == "physical"]
     grid = motion_grid(config.drive, sorted(config.weights_kg.values()))
-    admitted = planned = runs = 0
+    admitted = planned = runs = planned_broken = 0
     violations: list[str] = []
     worst = {"slack_s": 0.0, "travel_mm": 0.0, "tension_n": 0.0}
     for i, c in enumerate(grid):
@@ -48,7 +49,9 @@ def main() -> None:
         if p.breaches(config.envelope, RULE):
             continue
         admitted += 1
-        planned += p.worst.slack_share <= PREDICTABLE_SLACK
+        margin = min(p.margins(config.envelope, RULE).values())
+        plannable = margin >= PLAN_MARGIN and p.worst.slack_share <= PREDICTABLE_SLACK
+        planned += plannable
         rng = np.random.default_rng(i)
         for draw in range(args.draws):
             truth = draw_true_stand(stand, rng)
@@ -72,20 +75,22 @@ def main() -> None:
                 if bad
             ]
             if broken:
+                planned_broken += plannable
                 violations.append(
-                    f"{c.describe()} ({', '.join(effects) or 'no effect'}): {', '.join(broken)}"
+                    ("planner's set, " if plannable else "")
+                    + f"{c.describe()} ({', '.join(effects) or 'no effect'}): {', '.join(broken)}"
                     f" (slack {f.longest_slack_s:.2f} s, travel {f.weight_travel_m * 1e3:.0f}"
                     f" mm, peak {f.peak_tension_n:.0f} N)"
                 )
     print(
-        f"grid {len(grid)} motions; admitted by the prediction {admitted} (of them within "
-        f"the planner's slack share {planned}); {runs} runs on the other stand"
+        f"grid {len(grid)} motions; admitted by the prediction {admitted}, {planned} of them "
+        f"in the planner's set; {runs} runs on the other stand"
     )
     print(
         f"worst on the other stand: slack {worst['slack_s']:.2f} s, travel "
         f"{worst['travel_mm']:.0f} mm, peak {worst['tension_n']:.0f} N"
     )
-    print(f"violations: {len(violations)}")
+    print(f"violations: {len(violations)}, of them among the planner's: {planned_broken}")
     for line in violations:
         print(f"  {line}")
 

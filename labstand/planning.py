@@ -26,6 +26,10 @@ if TYPE_CHECKING:
 __all__ = ["PLAN_OPTIONS", "PlanAnswer", "plan_motion_for", "rivals_of", "signal_from_plan"]
 
 BASELINE = "none"
+#: A separation below this many noise units (RMS, beyond what refits absorb) counts as
+#: hardly telling the rivals apart [estimate]: their outputs differ by less than the
+#: gauges' noise, and a re-diagnosis may well not settle it.
+DECISIVE = 1.0
 #: At most this many pairs are separated (each costs one batch of runs per rival).
 MAX_PAIRS = 3
 
@@ -78,6 +82,11 @@ class PlanAnswer:
     noise: Noise
     budget_s: float
 
+    @property
+    def decisive(self) -> bool:
+        """The plan's worst-separated pair differs by at least ``DECISIVE`` noise units."""
+        return self.plan.best is not None and self.plan.expected_separation >= DECISIVE
+
     def line(self) -> str:
         """Why, in one line."""
         plan = self.plan
@@ -88,8 +97,9 @@ class PlanAnswer:
             )
         (a, b), sep = min(plan.separations.items(), key=lambda kv: kv[1])
         worst = plan.prediction.worst
+        weak = "" if self.decisive else f" only (below {DECISIVE:g}: hardly told apart)"
         return (
-            f"{plan.best.describe()} separates {a} from {b} by {sep:.1f} noise units; "
+            f"{plan.best.describe()} separates {a} from {b} by {sep:.1f} noise units{weak}; "
             f"predicted slack {worst.slack_share:.0%}, peak {worst.peak_tension_n:.0f} N, "
             f"weight travel {worst.weight_travel_m * 1e3:.0f} mm"
         )
@@ -104,6 +114,7 @@ class PlanAnswer:
                 {"rivals": [a, b], "separation": sep} for (a, b), sep in plan.separations.items()
             ],
             "expected_separation": plan.expected_separation,
+            "decisive": self.decisive,
             "predicted": None,
             "noise": {"u_m": self.noise.u_m, "force_n": self.noise.force_n},
             "searched": plan.searched,
