@@ -9,7 +9,7 @@ import os
 import sys
 import time
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from labstand.errors import CommandError, ExitCode
 from labstand.targets import FILE
@@ -20,7 +20,7 @@ if TYPE_CHECKING:  # imported where they run: `plan --help` loads no numba
     from sim.identify.traces import Trace
     from sim.planner import Noise
 
-__all__ = ["register", "run"]
+__all__ = ["diagnosed", "noise_of", "register", "run", "traces_of"]
 
 #: The search's default time budget, s (the grid takes ≈ 15–25 s on 2 cores).
 BUDGET_S = 40.0
@@ -74,17 +74,17 @@ def _check(args: argparse.Namespace) -> None:
         raise CommandError(f"--mass-kg: mass must be > 0 kg, got {args.mass_kg:g}", ExitCode.USAGE)
 
 
-def _traces(args: argparse.Namespace, config: StandConfig) -> list[Trace]:
-    """The recordings as diagnosis traces (each at --mass-kg, else its stored weight)."""
+def traces_of(paths: list[Path], mass_kg: float | None) -> list[Trace]:
+    """The recordings as diagnosis traces (each at ``mass_kg``, else its stored weight)."""
     from labstand.campaigns import stored_mass, trace_of, unique_names
     from recordings import RecordingError, open_recording
     from sim.identify import DiagnosisInputError
 
     traces = []
-    for path in args.recordings:
+    for path in paths:
         try:
             rec = open_recording(path)
-            mass = args.mass_kg
+            mass = mass_kg
             if mass is None:
                 mass, _ = stored_mass(path, rec.metadata.stand_config)
             traces.append(trace_of(path.name, rec.frame(), mass))
@@ -93,22 +93,21 @@ def _traces(args: argparse.Namespace, config: StandConfig) -> list[Trace]:
     return unique_names(traces)
 
 
-def _fitted(args: argparse.Namespace, config: StandConfig, traces: list[Trace]) -> FittedStand:
-    """The saved diagnosis, or one of the recordings made now."""
-    from labstand.fitted import fitted_from_dict, read_diagnosis
+def diagnosed(
+    traces: list[Trace], config: StandConfig, who: str
+) -> tuple[FittedStand, dict[str, Any]]:
+    """The recordings' diagnosis as the stand's model, and as JSON."""
+    from labstand.fitted import fitted_from_dict
     from sim.identify import diagnose
 
-    if args.diagnosis is not None:
-        return read_diagnosis(args.diagnosis)
-
     def progress(message: str) -> None:
-        print(f"labstand plan: {message}", file=sys.stderr, flush=True)
+        print(f"labstand {who}: {message}", file=sys.stderr, flush=True)
 
-    result = diagnose(traces, config.stand_params("final"), progress=progress)
-    return fitted_from_dict(result.to_dict(), Path("(the recordings' diagnosis)"))
+    result = diagnose(traces, config.stand_params("final"), progress=progress).to_dict()
+    return fitted_from_dict(result, Path("(the recordings' diagnosis)")), result
 
 
-def _noise(traces: list[Trace]) -> Noise:
+def noise_of(traces: list[Trace]) -> Noise:
     """The recordings' gauge noise (median over them), else the simulated gauges'."""
     import numpy as np
 
@@ -132,13 +131,18 @@ def run(args: argparse.Namespace) -> int:
 
     _check(args)
     config = load_config(args.stand)
-    traces = _traces(args, config)
-    fitted = _fitted(args, config, traces)
+    traces = traces_of(args.recordings, args.mass_kg)
+    if args.diagnosis is not None:
+        from labstand.fitted import read_diagnosis
+
+        fitted = read_diagnosis(args.diagnosis)
+    else:
+        fitted, _ = diagnosed(traces, config, "plan")
     masses = [args.mass_kg] if args.mass_kg is not None else sorted(config.weights_kg.values())
     limits = SafetyLimits()
     rule = SlackRule(limits.slack_force_n, limits.slack_max_s)
     started = time.perf_counter()
-    answer = plan_motion_for(fitted, config, masses, _noise(traces), rule, args.budget_s)
+    answer = plan_motion_for(fitted, config, masses, noise_of(traces), rule, args.budget_s)
     out = answer.to_dict()
     out["search_s"] = time.perf_counter() - started
     if args.output is not None:  # under a temporary name, renamed when whole
