@@ -22,6 +22,7 @@ from labstand.errors import CommandError, ExitCode
 if TYPE_CHECKING:
     from drivers.signals import DriveProfile
     from labstand.fitted import FittedStand
+    from labstand.session.safety import SafetyLimits
     from sim.config import StandConfig
     from sim.effects import EffectSpec
     from sim.envelope import Prediction, SlackRule
@@ -145,15 +146,19 @@ def check_motion(
     config: StandConfig,
     profile: DriveProfile,
     mass_kg: float,
-    rule: SlackRule,
+    safety: SafetyLimits,
     fitted: FittedStand | None,
     override: bool,
 ) -> Verdict:
     """``run``'s check: a motion predicted beyond the limits is refused (exit 3).
 
-    With ``override`` it is not: a warning on stderr, and the verdict says overridden
-    (the recording stores it).
+    ``safety``: the run's e-stop thresholds (its slack rule is predicted). With
+    ``override`` the motion is not refused: a warning on stderr, and the verdict says
+    overridden (the recording stores it).
     """
+    from sim.envelope import SlackRule
+
+    rule = SlackRule(safety.slack_force_n, safety.slack_max_s)
     verdict = predict_profile(config, profile, mass_kg, rule, fitted)
     if verdict.admissible:
         return verdict

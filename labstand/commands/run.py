@@ -154,7 +154,6 @@ class _Plan:
 def _check(args: argparse.Namespace) -> _Plan:
     """Every check that needs no device: usage (2) and refusals (3)."""
     from recordings.base import formats
-    from sim.envelope import SlackRule
 
     config = load_stand(args)
     spec, mass = signal_from_args(args, config)
@@ -198,10 +197,8 @@ def _check(args: argparse.Namespace) -> _Plan:
             ExitCode.REFUSED,
         )
     viewer = parse_address(args.foxglove) if args.foxglove is not None else None
-    rule = SlackRule(safety.slack_force_n, safety.slack_max_s)
-    verdict = check_motion(
-        config, profile, mass, rule, fitted_from_args(args), args.override_prediction
-    )
+    fitted = fitted_from_args(args)
+    verdict = check_motion(config, profile, mass, safety, fitted, args.override_prediction)
     return _Plan(config, spec, mass, backend, effects, safety, confirm, viewer, verdict)
 
 
