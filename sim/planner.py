@@ -37,8 +37,9 @@ from sim.envelope import (
     figures_of,
     worst_of,
 )
-from sim.model import BatchResult, Model, Variant
+from sim.model import BatchResult, Model
 from sim.params import StandParams
+from sim.prediction import corner_variants
 
 __all__ = [
     "PLAN_MARGIN",
@@ -182,17 +183,6 @@ def _padded(
     return out, [x.size for x in xs]
 
 
-def _corner_variants(stand: StandParams, spread: Spread) -> list[Variant]:
-    return [
-        {
-            "stiffness_n_m": stand.stiffness_n_m * k,
-            "damping_n_s_m": stand.damping_n_s_m * c,
-            "friction_scale": stand.friction_scale * f,
-        }
-        for k, c, f in spread.corners()
-    ]
-
-
 @dataclass(frozen=True)
 class Setting:
     """What the search needs besides the grid.
@@ -232,7 +222,7 @@ def _predictions(
     Also the runs themselves: motion i's corners are rows i·9 … i·9 + 8, centre first.
     """
     stand = setting.nominal.with_(mass_kg=mass)
-    corners = _corner_variants(stand, setting.spread)
+    corners = corner_variants(stand, setting.spread)
     rows = np.repeat(x, len(corners), axis=0)
     res = Model(stand, setting.named).run_batch(rows, setting.rate_hz, corners * len(x))
     out = []
@@ -310,7 +300,7 @@ class _RivalRuns:
 def _rival_runs(setting: Setting, mass: float, x: FloatArray) -> dict[str, _RivalRuns]:
     """Each rival on every motion (rows of x): at its values, and a step off each."""
     stand = setting.nominal.with_(mass_kg=mass)
-    centre = _corner_variants(stand, setting.spread)[0]
+    centre = corner_variants(stand, setting.spread)[0]
     runs = {}
     for rival in setting.rivals:
         variants = [centre] + [{**centre, **step} for step in param_steps(rival)]

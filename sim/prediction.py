@@ -18,7 +18,19 @@ from sim.envelope import Prediction, Spread, figures_of, worst_of
 from sim.model import Model, Variant
 from sim.params import StandParams
 
-__all__ = ["predict"]
+__all__ = ["corner_variants", "predict"]
+
+
+def corner_variants(stand: StandParams, spread: Spread) -> list[Variant]:
+    """The spread's centre and corners as the model's variants of ``stand``."""
+    return [
+        {
+            "stiffness_n_m": stand.stiffness_n_m * k,
+            "damping_n_s_m": stand.damping_n_s_m * c,
+            "friction_scale": stand.friction_scale * f,
+        }
+        for k, c, f in spread.corners()
+    ]
 
 
 def predict(
@@ -47,14 +59,7 @@ def predict(
     slack_force_n
         The slack rule's threshold, N.
     """
-    variants: list[Variant] = [
-        {
-            "stiffness_n_m": stand.stiffness_n_m * k,
-            "damping_n_s_m": stand.damping_n_s_m * c,
-            "friction_scale": stand.friction_scale * f,
-        }
-        for k, c, f in spread.corners()
-    ]
+    variants = corner_variants(stand, spread)
     res = Model(stand, effects).run_batch(x_m, rate_hz, variants)
     figures = [
         figures_of(res.true_force_n[i], res.force_n[i], res.true_u_m[i], rate_hz, slack_force_n)
