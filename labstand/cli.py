@@ -51,6 +51,8 @@ COMMANDS: dict[str, str] = {
     "doctor": "check a recording and say what recover would do (writes nothing)",
     "diagnose": "find which unmodelled effect explains the gap between model and recordings",
     "diagnose-check": "score the diagnosis on generated recordings whose effect is withheld",
+    "plan": "the next test: the admissible motion that best separates a diagnosis' rivals",
+    "campaign": "run, diagnose, plan the next test and run it, until the answer is certain",
     "completion": "print a shell completion script (bash, zsh, tcsh)",
 }
 

@@ -21,6 +21,7 @@ from typing import Any
 
 from drivers.calibration import GaugeCalibration
 from drivers.limits import DriveLimits
+from sim.envelope import StandEnvelope
 from sim.params import FrictionTable, StandParams
 
 __all__ = [
@@ -168,6 +169,7 @@ _FIXED_TABLES: dict[str, dict[str, Check]] = {
         "speed_max_m_s": POSITIVE,
         "accel_max_m_s2": POSITIVE,
     },
+    "safety": {"weight_travel_max_mm": POSITIVE, "fibre_tension_max_n": POSITIVE},
     "acquisition": {"sample_rate_hz": _number(0.0, MAX_SAMPLE_RATE_HZ)},
     "gauges": {
         "force_n_per_count": POSITIVE,
@@ -201,6 +203,8 @@ class StandConfig:
     parameter_sets: Mapping[str, ParameterSet]
     friction_tables: Mapping[str, FrictionTable]
     drive: DriveLimits
+    #: What the stand survives: ``labstand run`` refuses a motion predicted beyond it.
+    envelope: StandEnvelope
     sample_rate_hz: float
     gauges: GaugeCalibration
     source: str
@@ -316,6 +320,7 @@ def config_from_dict(data: Mapping[str, Any], source: str = DEFAULT_SOURCE) -> S
         msg = "must be shorter than free_length_m (the fibre cannot reach the weight)"
         raise _complain(source, "geometry", "lateral_offset_m", msg)
     drive = merged["drive"]
+    safety = merged["safety"]
     gauges = merged["gauges"]
     return StandConfig(
         geometry=geometry,
@@ -327,6 +332,10 @@ def config_from_dict(data: Mapping[str, Any], source: str = DEFAULT_SOURCE) -> S
             amplitude_max_m=drive["amplitude_max_mm"] / 1e3,
             speed_max_m_s=float(drive["speed_max_m_s"]),
             accel_max_m_s2=float(drive["accel_max_m_s2"]),
+        ),
+        envelope=StandEnvelope(
+            weight_travel_max_m=safety["weight_travel_max_mm"] / 1e3,
+            fibre_tension_max_n=float(safety["fibre_tension_max_n"]),
         ),
         sample_rate_hz=float(merged["acquisition"]["sample_rate_hz"]),
         gauges=GaugeCalibration(**{k: float(v) for k, v in gauges.items()}),

@@ -67,8 +67,12 @@ def add_metadata_options(parser: argparse.ArgumentParser) -> None:
     )
 
 
-def metadata_options(args: argparse.Namespace) -> dict[str, Any]:
-    """The keywords of ``make_metadata`` / ``with_changes`` the options above give."""
-    out: dict[str, Any] = {"tags": tuple(args.tag)} if args.tag else {}
+def metadata_options(args: argparse.Namespace, tags: tuple[str, ...] = ()) -> dict[str, Any]:
+    """The keywords of ``make_metadata`` / ``with_changes`` the options above give.
+
+    ``tags``: more tags the command adds (a run against its safety prediction).
+    """
+    all_tags = (*args.tag, *tags)
+    out: dict[str, Any] = {"tags": tuple(all_tags)} if all_tags else {}
     out.update({k: getattr(args, k) for k in ("operator", "sample") if getattr(args, k)})
     return out

@@ -36,6 +36,7 @@ from labstand.commands.common import (
 from labstand.commands.simulate import add_signal_options, signal_from_args
 from labstand.errors import CommandError, ExitCode
 from labstand.live.address import ViewerAddress, parse_address
+from labstand.prediction import Verdict, add_prediction_options, check_motion, fitted_from_args
 from labstand.session import (
     Outcome,
     Preflight,
@@ -91,6 +92,7 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
         help="sim: switch an unmodelled effect on in the simulated stand, at default "
         "parameters or those given (repeatable; docs/effects.md)",
     )
+    add_prediction_options(parser, override=True)
     safety = parser.add_argument_group("emergency-stop thresholds (docs/acquisition.md)")
     defaults = SafetyLimits()
     for name, unit, what in (
@@ -146,6 +148,7 @@ class _Plan:
     safety: SafetyLimits
     confirm: bool
     viewer: ViewerAddress | None
+    verdict: Verdict
 
 
 def _check(args: argparse.Namespace) -> _Plan:
@@ -177,7 +180,7 @@ def _check(args: argparse.Namespace) -> _Plan:
         slack_max_s=args.slack_max_s,
         gauge_timeout_s=args.gauge_timeout_s,
     )
-    plan_motion(spec, config.drive)  # LimitError: refused before anything is touched
+    profile = plan_motion(spec, config.drive)  # LimitError: refused before anything is touched
     suffix = args.output.suffix.lower()
     if suffix not in (writable := suffixes("write")):
         raise CommandError(
@@ -192,7 +195,9 @@ def _check(args: argparse.Namespace) -> _Plan:
             ExitCode.REFUSED,
         )
     viewer = parse_address(args.foxglove) if args.foxglove is not None else None
-    return _Plan(config, spec, mass, backend, effects, safety, confirm, viewer)
+    fitted = fitted_from_args(args)
+    verdict = check_motion(config, profile, mass, safety, fitted, args.override_prediction)
+    return _Plan(config, spec, mass, backend, effects, safety, confirm, viewer, verdict)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -266,6 +271,7 @@ def _session(
         code = ExitCode.REFUSED if err.refused else ExitCode.FAILURE
         raise CommandError(f"pre-flight: {err}", code) from err
     _summary(session, pre, args.output)
+    _say(f"  prediction: {plan.verdict.line()}")
     if plan.confirm:
         with session.keepalive():
             _confirm()
@@ -285,9 +291,9 @@ def _session(
             signal={**plan.spec.to_dict(), "situation": args.situation},
             effects=tuple(Effect(e.name, e.resolved()) for e in plan.effects),
             operator_note=args.note,
-            **metadata_options(args),
+            **metadata_options(args, plan.verdict.tags),
         )
-        return _record(session, devices, metadata, args, stop, title, live)
+        return _record(session, devices, metadata, args, stop, title, live, plan.verdict)
 
 
 def _record(
@@ -298,6 +304,7 @@ def _record(
     stop: StopRequest,
     title: str,
     live: LiveView | None,
+    verdict: Verdict,
 ) -> RunResult:
     """The run itself, recording into the output; the file is closed on every path."""
     writer = open_writer(args.output, metadata)
@@ -305,6 +312,8 @@ def _record(
     try:
         if args.note:
             pipe.put_event(0, "note", args.note)
+        if verdict.overridden:
+            pipe.put_event(0, "note", verdict.override_note())
         with session.display:
             return session.run(pipe, stop, title)
     finally:

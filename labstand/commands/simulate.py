@@ -21,14 +21,17 @@ from labstand.commands.common import (
     metadata_options,
 )
 from labstand.errors import CommandError, ExitCode
+from labstand.prediction import add_prediction_options, fitted_from_args
 from labstand.targets import FILE
 from sim.situations import SITUATIONS, situation
 
 if TYPE_CHECKING:
     from numpy.typing import NDArray
 
+    from labstand.prediction import Verdict
     from sim.config import StandConfig
     from sim.effects import EffectSpec
+    from sim.envelope import SlackRule
     from sim.params import StandParams
     from sim.results import SimResult
 
@@ -47,10 +50,22 @@ def add_signal_options(parser: argparse.ArgumentParser) -> None:
     group.add_argument("--dwell-start-s", type=float, help="rest before the motion, s (0.5)")
     group.add_argument("--dwell-end-s", type=float, help="rest after the motion, s (1.0)")
     group.add_argument("--mass-kg", type=float, help="weight mass, kg (default: the stand's)")
+    group.add_argument(
+        "--plan",
+        type=Path,
+        metavar="PLAN.json",
+        help="the motion and weight a `labstand plan -o PLAN.json` chose (no other signal "
+        "option beside it)",
+    )
 
 
 def signal_from_args(args: argparse.Namespace, config: StandConfig) -> tuple[SignalSpec, float]:
-    """The signal and weight mass the options ask for (a situation, then overrides)."""
+    """The signal and weight mass the options ask for (a plan, or a situation and overrides)."""
+    if args.plan is not None:
+        from labstand.planning import PLAN_OPTIONS, signal_from_plan
+
+        given = [f"--{o.replace('_', '-')}" for o in PLAN_OPTIONS if getattr(args, o) is not None]
+        return signal_from_plan(args.plan, given)
     overrides: dict[str, Any] = {}
     if args.amplitude_mm is not None:
         overrides["amplitude_m"] = args.amplitude_mm / 1e3
@@ -96,6 +111,7 @@ def register(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     parser.add_argument("-o", "--output", type=Path, help="write the run here (.csv, ...)")
     parser.add_argument("--plot", type=Path, metavar="PNG", help="plot x, u and F to a PNG")
     add_metadata_options(parser)
+    add_prediction_options(parser, override=False)
     parser.add_argument("--json", action="store_true", help="print a JSON summary")
     effects = parser.add_argument_group("unmodelled effects (docs/effects.md)")
     effects.add_argument(
@@ -141,6 +157,7 @@ def run(args: argparse.Namespace) -> int:
     params = config.stand_params(args.params, mass)
     _, x_m = profile.sample(config.sample_rate_hz)
     effects = parse_effects(args.effect or [])
+    verdict = _prediction(args, config, profile, mass)
     started = time.perf_counter()
     if effects or args.noise:
         result, truth = _simulate_real_like(x_m, config.sample_rate_hz, params, effects, args)
@@ -154,6 +171,12 @@ def run(args: argparse.Namespace) -> int:
     summary["params"] = args.params
     summary["situation"] = args.situation
     summary["wall_s"] = elapsed
+    summary["prediction"] = {
+        "admissible": verdict.admissible,
+        "breaches": verdict.breaches,
+        "model": verdict.model,
+        **verdict.prediction.to_dict(config.envelope, _slack_rule()),
+    }
     if args.output is not None:
         write_simulation(
             args.output,
@@ -176,6 +199,26 @@ def run(args: argparse.Namespace) -> int:
     else:
         _print_summary(summary)
     return 0
+
+
+def _slack_rule() -> SlackRule:
+    """The slack e-stop rule of a run at the default thresholds."""
+    from labstand.session.safety import SafetyLimits
+    from sim.envelope import SlackRule
+
+    limits = SafetyLimits()
+    return SlackRule(limits.slack_force_n, limits.slack_max_s)
+
+
+def _prediction(
+    args: argparse.Namespace, config: StandConfig, profile: DriveProfile, mass_kg: float
+) -> Verdict:
+    """What ``run`` would predict for this motion; a warning on stderr where it would refuse."""
+    from labstand.prediction import predict_profile, warn_simulated
+
+    verdict = predict_profile(config, profile, mass_kg, _slack_rule(), fitted_from_args(args))
+    warn_simulated(verdict)
+    return verdict
 
 
 def _simulate_real_like(

@@ -115,11 +115,13 @@ def test_garbage_on_the_gauge_line_is_counted_and_the_run_goes_on(
 
 
 def test_a_flung_weight_is_an_estop(labstand: Callable[..., Outcome], tmp_path: Path) -> None:
-    # rectangular 30 mm steps at 2 Hz fling the heavy weight: slack for ≈ 0.37 s
+    # rectangular 30 mm steps at 2 Hz fling the heavy weight: slack for ≈ 0.37 s. The
+    # safety prediction refuses it before moving; overridden, the e-stop must catch it.
     out = tmp_path / "flung.mcap"
     args = ["--signal", "rectangular", "--amplitude-mm", "30", "--frequency-hz", "2"]
-    result = labstand("run", *SHORT, *args, "-o", out)
+    result = labstand("run", *SHORT, *args, "--override-prediction", "-o", out)
     assert result.code == ExitCode.ESTOP, result.err
+    assert "labstand: warning: prediction overridden: weight travel" in result.err
     assert result.last_error_line.startswith("labstand: e-stop: fibre slack (F < 2 N) for 0.2")
     rec = readable(out)
     ends_disabled(rec)

@@ -1,0 +1,108 @@
+"""Benchmark: ``labstand plan``'s search, batched, beside the same search one run at a time.
+
+The rivals of the diagnosis of a campaign with a 1.1 ms force-channel skew (named:
+force_gauge_dynamics, indistinguishable from channel_time_skew), the stand file's two
+weights, the whole grid. Ours: ``sim.planner.search`` (each chunk of 24 motions is one
+batch for the prediction's 9 corners and one per rival, its centre and a step of each of
+its parameters, on all cores). Reference, in the same run: the same judgements with one
+``Model.run`` per motion and corner (and per rival and parameter step on the admissible
+motions) on the grid's first 24 motions, scaled to the whole grid. Median of three runs
+each (a first run compiles; it is not counted).
+
+Run: ``.venv/bin/python benchmarks/bench_plan.py``.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from drivers.signals import plan_motion
+from sim.config import default_config
+from sim.effects import EffectSpec
+from sim.envelope import FITTED_SPREAD, Prediction, SlackRule, figures_of, worst_of
+from sim.model import Model
+from sim.planner import (
+    CHUNK,
+    PREDICTABLE_SLACK,
+    Noise,
+    Rival,
+    Setting,
+    motion_grid,
+    param_steps,
+    search,
+)
+
+GAUGE = EffectSpec("force_gauge_dynamics", {"cutoff_hz": 221.65, "damping_ratio": 0.715})
+SKEW = EffectSpec("channel_time_skew", {"force_skew_s": 0.0011})
+REFERENCE_SAMPLE = 24  # motions the one-at-a-time reference runs
+
+
+def setting() -> Setting:
+    config = default_config()
+    return Setting(
+        nominal=config.stand_params("final"),
+        spread=FITTED_SPREAD,
+        named=(GAUGE,),
+        rivals=(Rival("gauge", (GAUGE,)), Rival("skew", (SKEW,))),
+        pairs=(("gauge", "skew"),),
+        noise=Noise(5e-6, 0.1),
+        envelope=config.envelope,
+        rule=SlackRule(2.0, 0.25),
+        limits=config.drive,
+        rate_hz=config.sample_rate_hz,
+    )
+
+
+def one_at_a_time(s: Setting, motions: list) -> None:  # type: ignore[type-arg]
+    for c in motions:
+        x = plan_motion(c.spec, s.limits).sample(s.rate_hz)[1]
+        stand = s.nominal.with_(mass_kg=c.mass_kg)
+        figures = []
+        for k, d, f in s.spread.corners():
+            variant = stand.with_(
+                stiffness_n_m=stand.stiffness_n_m * k,
+                damping_n_s_m=stand.damping_n_s_m * d,
+                friction_scale=stand.friction_scale * f,
+            )
+            r = Model(variant, s.named).run(x, s.rate_hz)
+            figures.append(figures_of(r.true_force_n, r.force_n, r.true_u_m, s.rate_hz, 2.0))
+        worst = Prediction(figures[0], worst_of(figures), len(figures))
+        if worst.breaches(s.envelope, s.rule) or worst.worst.slack_share > PREDICTABLE_SLACK:
+            continue
+        for rival in s.rivals:
+            model = Model(stand, rival.effects)
+            model.run(x, s.rate_hz)
+            for step in param_steps(rival):
+                model.variant(step).run(x, s.rate_hz)
+
+
+def main() -> None:
+    config = default_config()
+    s = setting()
+    grid = motion_grid(config.drive, sorted(config.weights_kg.values()))
+    print(f"grid: {len(grid)} motions, {CHUNK} per batch")
+    search(s, grid[:CHUNK], 600.0)  # compile
+    times, plan = [], None
+    for _ in range(3):
+        started = time.perf_counter()
+        plan = search(s, grid, 600.0)
+        times.append(time.perf_counter() - started)
+    assert plan is not None and plan.best is not None
+    print(f"  ours: batched search           {np.median(times):6.1f} s  (median of 3)")
+    print(f"    {plan.admissible} admissible; {plan.best.describe()}, "
+          f"separation {plan.expected_separation:.1f} noise units")  # fmt: skip
+    sample = grid[:REFERENCE_SAMPLE]
+    one_at_a_time(s, sample[:1])
+    ref = []
+    for _ in range(3):
+        started = time.perf_counter()
+        one_at_a_time(s, sample)
+        ref.append((time.perf_counter() - started) * len(grid) / len(sample))
+    print(f"  reference: one run at a time  {np.median(ref):6.1f} s  (scaled from "
+          f"{REFERENCE_SAMPLE} motions)")  # fmt: skip
+
+
+if __name__ == "__main__":
+    main()

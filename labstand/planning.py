@@ -1,0 +1,215 @@
+"""``labstand plan``'s parts: the rivals a diagnosis leaves, the search, the answer.
+
+The rivals (``rivals_of``): the named effect against each candidate the recordings could
+not tell from it (``indistinguishable_from``); failing those, against the runner-up of the
+ranking and against the baseline alone; with nothing named, the ranking's two best
+against the baseline and each other. Each rival is the diagnosis' fitted baseline plus
+its effect at the parameters its own refit found (the ranking's ``params``).
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from labstand.errors import CommandError, ExitCode
+
+if TYPE_CHECKING:
+    from drivers.signals import SignalSpec
+    from labstand.fitted import FittedStand
+    from sim.config import StandConfig
+    from sim.envelope import SlackRule
+    from sim.planner import Noise, Plan, Rival
+
+__all__ = ["PLAN_OPTIONS", "PlanAnswer", "plan_motion_for", "rivals_of", "signal_from_plan"]
+
+BASELINE = "none"
+#: A separation below this many noise units (RMS, beyond what refits absorb) counts as
+#: hardly telling the rivals apart [estimate]: their outputs differ by less than the
+#: gauges' noise, and a re-diagnosis may well not settle it.
+DECISIVE = 1.0
+#: At most this many pairs are separated (each costs one batch of runs per rival).
+MAX_PAIRS = 3
+
+
+def rivals_of(fitted: FittedStand) -> tuple[list[Rival], list[tuple[str, str]]]:
+    """The rival models and the pairs to separate; CommandError (2) if there are none."""
+    from sim.effects import EffectSpec
+    from sim.planner import Rival
+
+    named = list(fitted.effects)
+    ranked = [name for name in fitted.rivals if name not in {e.name for e in named}]
+    pairs: list[tuple[str, str]] = []
+    if named:
+        first = named[0].name
+        others = [n for n in fitted.indistinguishable.get(first, []) if n in fitted.rivals]
+        if not others:
+            others = [*ranked[:1], BASELINE]
+        pairs = [(first, other) for other in others]
+    elif ranked:
+        pairs = [(ranked[0], BASELINE)]
+        if len(ranked) > 1:
+            pairs += [(ranked[0], ranked[1]), (ranked[1], BASELINE)]
+    if not pairs:
+        raise CommandError(
+            f"{fitted.source}: no rival explanations to separate (nothing named, no ranked "
+            "candidate with fitted parameters)",
+            ExitCode.USAGE,
+        )
+    pairs = pairs[:MAX_PAIRS]
+    rest = tuple(named[1:])
+    models: dict[str, Rival] = {}
+    for name in {n for pair in pairs for n in pair}:
+        if name == BASELINE:
+            models[name] = Rival(name, rest)
+        elif named and name == named[0].name:
+            models[name] = Rival(name, tuple(named))
+        else:
+            models[name] = Rival(name, (EffectSpec(name, fitted.rivals[name]), *rest))
+    return [models[n] for n in sorted(models)], pairs
+
+
+@dataclass(frozen=True)
+class PlanAnswer:
+    """The plan with what it was searched against, for the line and the JSON."""
+
+    plan: Plan
+    fitted: FittedStand
+    config: StandConfig
+    rule: SlackRule
+    noise: Noise
+    budget_s: float
+
+    @property
+    def decisive(self) -> bool:
+        """The plan's worst-separated pair differs by at least ``DECISIVE`` noise units."""
+        return self.plan.best is not None and self.plan.expected_separation >= DECISIVE
+
+    def line(self) -> str:
+        """Why, in one line."""
+        plan = self.plan
+        if plan.best is None or plan.prediction is None:
+            return (
+                f"no admissible motion among the {plan.searched} searched: none is predicted "
+                "within the limits and free of slack"
+            )
+        (a, b), sep = min(plan.separations.items(), key=lambda kv: kv[1])
+        worst = plan.prediction.worst
+        weak = "" if self.decisive else f" only (below {DECISIVE:g}: hardly told apart)"
+        return (
+            f"{plan.best.describe()} separates {a} from {b} by {sep:.1f} noise units{weak}; "
+            f"predicted slack {worst.slack_share:.0%}, peak {worst.peak_tension_n:.0f} N, "
+            f"weight travel {worst.weight_travel_m * 1e3:.0f} mm"
+        )
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON: signal (as ``run`` takes it), separates, expected_separation, predicted."""
+        plan = self.plan
+        out: dict[str, Any] = {
+            "why": self.line(),
+            "signal": None,
+            "separates": [
+                {"rivals": [a, b], "separation": sep} for (a, b), sep in plan.separations.items()
+            ],
+            "expected_separation": plan.expected_separation,
+            "decisive": self.decisive,
+            "predicted": None,
+            "noise": {"u_m": self.noise.u_m, "force_n": self.noise.force_n},
+            "searched": plan.searched,
+            "admissible": plan.admissible,
+            "complete": plan.complete,
+            "budget_s": self.budget_s,
+            # the model the plan was predicted with: `run --plan` predicts with it too
+            "diagnosis": {
+                key: self.fitted.raw.get(key)
+                for key in ("baseline_fit", "baseline_intervals", "effects", "verdict")
+            },
+        }
+        if plan.best is not None and plan.prediction is not None:
+            out["signal"] = {**plan.best.spec.to_dict(), "mass_kg": plan.best.mass_kg}
+            worst = plan.prediction.worst
+            out["predicted"] = {
+                "peak_tension_n": worst.peak_tension_n,
+                "slack_share": worst.slack_share,
+                "longest_slack_s": worst.longest_slack_s,
+                "weight_travel_mm": worst.weight_travel_m * 1e3,
+                "margins": plan.prediction.margins(self.config.envelope, self.rule),
+                "runs": plan.prediction.runs,
+            }
+        return out
+
+
+def plan_motion_for(
+    fitted: FittedStand,
+    config: StandConfig,
+    masses_kg: list[float],
+    noise: Noise,
+    rule: SlackRule,
+    budget_s: float,
+) -> PlanAnswer:
+    """Search the stand's motions for the one that best separates the diagnosis' rivals."""
+    from sim.planner import Setting, motion_grid, search
+
+    rivals, pairs = rivals_of(fitted)
+    setting = Setting(
+        nominal=config.stand_params("final"),
+        spread=fitted.spread(),
+        named=fitted.effects,
+        rivals=tuple(rivals),
+        pairs=tuple(pairs),
+        noise=noise,
+        envelope=config.envelope,
+        rule=rule,
+        limits=config.drive,
+        rate_hz=config.sample_rate_hz,
+    )
+    plan = search(setting, motion_grid(config.drive, masses_kg), budget_s)
+    return PlanAnswer(plan, fitted, config, rule, noise, budget_s)
+
+
+#: The signal options ``run --plan`` takes from the plan (the command line may not add).
+PLAN_OPTIONS = (
+    "situation", "signal", "amplitude_mm", "frequency_hz", "cycles", "ramp_fraction",
+    "dwell_start_s", "dwell_end_s", "mass_kg",
+)  # fmt: skip
+
+
+def signal_from_plan(path: Path, given: list[str]) -> tuple[SignalSpec, float]:
+    """The motion and mass of a plan (``labstand plan -o``); exit 2 if it is not one.
+
+    ``given``: signal options also on the command line: refused, the plan is run as it is.
+    """
+    from drivers.signals import Shape, SignalSpec
+
+    if given:
+        raise CommandError(
+            f"--plan runs the plan's motion as it is: no {', '.join(given)} beside it",
+            ExitCode.USAGE,
+        )
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise CommandError(f"no such file: {path}", ExitCode.USAGE) from None
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as err:
+        raise CommandError(f"{path}: not a plan: {err}", ExitCode.USAGE) from None
+    signal = data.get("signal") if isinstance(data, dict) else None
+    if not isinstance(signal, dict):
+        raise CommandError(f"{path}: not a plan: no signal (an empty plan?)", ExitCode.USAGE)
+    try:
+        spec = SignalSpec(
+            shape=Shape(signal["shape"]),
+            amplitude_m=float(signal["amplitude_mm"]) / 1e3,
+            frequency_hz=float(signal["frequency_hz"]),
+            cycles=int(signal["cycles"]),
+            ramp_fraction=float(signal["ramp_fraction"]),
+            dwell_start_s=float(signal["dwell_start_s"]),
+            dwell_end_s=float(signal["dwell_end_s"]),
+        )
+        mass = float(signal["mass_kg"])
+    except (KeyError, TypeError, ValueError) as err:
+        raise CommandError(f"{path}: not a plan's signal: {err!r}", ExitCode.USAGE) from None
+    if signal["cycles"] != spec.cycles:
+        raise CommandError(f"{path}: cycles must be a whole number", ExitCode.USAGE)
+    return spec, mass
