@@ -3,7 +3,7 @@
 The planner searches ``sim.planner.motion_grid``; ``labstand run`` admits a motion when
 its prediction (the nominal model over ``NOMINAL_SPREAD``) keeps within the limits. Here
 every grid motion the prediction admits, for both weights, is simulated on the
-independently written stand (``sim.otherstand``: its own integrator and effect forms,
+independently written stand (``sim.checks.otherstand``: its own integrator and effect forms,
 not the model that predicted) at three true stands drawn as ``diagnose-check`` draws
 them (k ×0.8–1.25, c ×0.7–1.4, friction ×0.8–1.25), each with one of the other stand's
 physical effects drawn at random (or none), and checked against the limits: the slack
@@ -21,10 +21,10 @@ import argparse
 import numpy as np
 
 from drivers.signals import plan_motion
+from sim.checks.otherstand import OTHER_EFFECTS, simulate
+from sim.checks.otherstand.campaign import draw_true_stand
 from sim.config import default_config
 from sim.envelope import NOMINAL_SPREAD, SlackRule, figures_of
-from sim.otherstand import OTHER_EFFECTS, simulate
-from sim.otherstand.campaign import draw_true_stand
 from sim.planner import PLAN_MARGIN, PREDICTABLE_SLACK, motion_grid
 from sim.prediction import predict
 
