@@ -1,31 +1,46 @@
-"""Compiled integrator of the baseline model plus the physical effects of STAND.md §5.
+"""The compiled model: one integrator, its runners, the built-in terms (source text only).
 
-One kernel serves every combination of effects: each parameter row carries a flag per
-effect; inactive effects keep their states at zero and add exact zeros, so with every flag
-off the arithmetic is ``sim.kernel``'s operation for operation (bit-identical results).
-The baseline's event handling is generalised from one fibre to up to two fibre
-*segments* (drive side and weight side, split by the pulley when it has its own degree of
-freedom): each is taut (T = kδ + cδ̇ + q) or slack (T = 0), re-checked at every step's
-start; the earliest switch of any segment, or of the friction branch (v = ±v_reg), is
-located on the cubic Hermite interpolant of the whole state and the step split there.
-Time is i·dt; x is linear inside a sample interval.
+Never imported as itself: ``sim.physics.compose`` writes it, composed for a set of terms,
+into a hash-named module (its three marked blocks: the layout's constants, the state's
+tuple helpers, the added effects' forces). The empty set is the baseline of STAND.md §2;
+the union has every built-in term, and an effect switched off in a row adds exact zeros,
+so both give the baseline's numbers bit for bit with every effect off.
 
-State y, an 11-tuple (``Y_*``): weight u, v; pulley rim displacement s, ṡ; Maxwell branch
-forces q₁, q₂; string-mode amplitudes and rates a₁, ȧ₁ (drive span), a₂, ȧ₂ (weight
-span); LuGre bristle z. The run's constants live in one array c: the parameter row
-(``P_*``, ``R_*``), derived constants (``D_*``), the discrete state (``S_*``: taut flags,
-friction branch, pulley-jump seat and slack episode, bearing presliding) and the friction
-table. Stiff effects raise the RK4 substeps per sample from estimates of their fastest
-rates (``_substeps``).
+The baseline (state u, v: the weight's displacement up the incline and its velocity).
+The drive position x is given at the sample times and is linear inside each sample
+interval, so every RK4 step sees a smooth right-hand side. The fibre is *taut*
+(T = k·δ + c·δ̇) or *slack* (T = 0), switched by events located inside the step: taut →
+slack when k·δ + c·δ̇ falls through 0 (T is continuous there); slack → taut when δ rises
+through 0 (T jumps by c·δ̇), or when δ > 0 and k·δ + c·δ̇ rises through 0. The friction
+law has branches too: sliding up (v ≥ v_reg), sliding down (v ≤ −v_reg) and the linear
+regularisation band between; at the top of a free flight the weight crosses the band
+(2 mm/s wide) in a fraction of a step, and a step straddling it would see friction flip
+sign inside one RK4 step — a first-order error that decides when the next snatch
+happens. So the branch too is held fixed within a step and switched at located crossings
+of v = ±v_reg. The step is split at the earliest located switch and each part integrated
+with its own right-hand side, so neither the jump nor the kinks cost the method its
+order; crossings are found on the cubic Hermite interpolant of the step (fourth order).
+Time is i·dt, never summed.
+
+The effects' terms generalise the events from one fibre to up to two fibre *segments*
+(drive side and weight side, split by the pulley when it has its own degree of freedom),
+each taut (T = kδ + cδ̇ + q) or slack, re-checked at every step's start. Their states
+(``layout.STATES``): pulley rim displacement s, ṡ; Maxwell branch forces q₁, q₂;
+string-mode amplitudes and rates a₁, ȧ₁ (drive span), a₂, ȧ₂ (weight span); LuGre
+bristle z. The run's constants live in one array c (``layout``): the parameter row,
+derived constants, the discrete state (taut flags, friction branch, pulley-jump seat and
+slack episode, bearing presliding) and the friction table. Stiff terms raise the RK4
+substeps per sample from estimates of their fastest rates (``_substeps``) and take the
+exponential step (``_etdrk4``) where it pays.
 
 Speed: the hot functions take c and scalars or tuples only; passing arrays to small
 jitted functions costs 7 machine words per array per call (measured: 60 → 9 ms for 10 s
-at 2 kHz). All numba code of the augmented dynamics lives in this one file on purpose:
-numba's cache does not notice changes in jitted functions imported from other modules,
-so splitting it would let stale machine code survive an edit. An effect added from
-outside (``sim.effects.registry.register``) runs in a copy of this file composed with
-its force (``sim.effects._compose``), named by a hash of both sources for that reason.
-Each effect's parameters, ranges and hooks are in its own module (``sim/effects/*.py``).
+at 2 kHz). A term that is out of the set is pruned at compile time (``ON_*``), so the
+baseline runs on two states without the terms' branches. All numba code of the model is
+in this one text on purpose: numba's cache does not notice changes in jitted functions
+or constants imported from other modules; a composed module's name is a hash of its
+whole text instead. Each effect's parameters, ranges and hooks are in its own module
+(``sim/effects/*.py``).
 """
 
 from __future__ import annotations
@@ -35,49 +50,225 @@ import math
 import numpy as np
 from numba import njit, prange
 
-# Parameter row: sim.kernel's eight P_* first (same values as sim.model.param_vector), then
-# stand geometry, then per effect a flag (1.0 on) and its parameters in registry order.
-(P_MASS, P_PROJ, P_STIFF, P_DAMP, P_FRICTION_N, P_GRAVITY_N, P_PRELOAD, P_VREG) = range(8)
-(R_DRIVE_SPAN, R_FREE_SPAN, R_FIBRE_LEN, R_LIN_DENSITY, R_SIN_BETA, R_G_PERP_WEIGHT_SPAN,
- R_GRAVITY, R_SIN_HALF_WRAP, R_RADIUS) = range(8, 17)  # fmt: skip
-(R_VE_ON, R_VE_K, R_VE_TAU) = range(17, 20)
-(R_TV_ON, R_TV_ZETA, R_TV_LOAD, R_TV_TILT) = range(20, 24)
-(R_PJ_ON, R_PJ_STEP, R_PJ_DEPTH) = range(24, 27)
-(R_PI_ON, R_PI_J, R_PI_TORQUE, R_PI_LOAD, R_PI_PRESLIDE) = range(27, 32)
-(R_SS_ON, R_SS_RATIO, R_SS_VS, R_SS_SIGMA) = range(32, 36)
-(R_SL_ON, R_SL_MU) = range(36, 38)
-(R_DG_ON, R_DG_GAIN, R_DG_OFFSET) = range(38, 41)
-(R_CS_ON, R_CS_FORCE, R_CS_DISP) = range(41, 44)
-(R_FG_ON, R_FG_FC, R_FG_ZETA) = range(44, 47)
-R_PJ_ONSET = 47  # appended (the pulley jump's third and fourth parameters came last)
-R_PJ_DWELL = 48
-R_PJ_SEATS = 49
-R_SS_EXP = 50
-# Effects added outside this file (``sim.effects.registry.register``): R_X_ON is 1.0 when
-# any is on; each has a flag and its parameters in the N_X columns from R_X.
-R_X_ON = 51
-R_X = 52
-N_X = 8
-N_ROW = R_X + N_X
-# Derived constants, then the discrete state, then the friction table: indices into c.
-(D_NSEG, D_T0, D_K1, D_C1, D_K2, D_C2, D_D10, D_D20, D_MP, D_FB0, D_FBL, D_SIGP, D_KB1,
- D_KB2, D_RELAX, D_W1, D_W2, D_F1, D_F2, D_CM1, D_CM2, D_AR1SQ, D_AR2SQ, D_ST1, D_ST2,
- D_AR1, D_AR2, D_SS_ON, D_SIG0, D_SIG1, D_SL, D_OSC, D_REAL, D_DYN, D_ZONES,
- ) = range(N_ROW, N_ROW + 35)  # fmt: skip
-(S_TAUT1, S_TAUT2, S_ZONE, S_LOFF, S_LBASE, S_DEPTH, S_PZ, S_PS0, S_SLACKT,
- ) = range(N_ROW + 35, N_ROW + 44)  # fmt: skip
-# Exponential integration of the stiff decays (``_etdrk4``): on in this interval; the rim's
-# decay rate at rest; the oscillation bound that remains with them exact; the rim's weights
-# (``_rim_weights``: rate, step, then the six weights).
-E_ON, E_RIM, E_OSC, E_RATE, E_H, E_W = range(N_ROW + 44, N_ROW + 50)
-# The pulley seat follows the recorded slack episodes (``_advance``'s ``seat``), not the
-# model's: 1.0 while a run is given them.
-S_RECSEAT = N_ROW + 55
-C_TABLE = N_ROW + 56  # c[C_TABLE] = knots n, then the n knots, then coef (4, n − 1) by rows
+# <layout>: ``sim.physics.compose`` writes the composed set's constants here, as literals
+# (``layout.constants``); this file, never run as itself, reads the union's.
+from sim.physics.layout import (
+    C_TABLE,
+    D_AR1,
+    D_AR1SQ,
+    D_AR2,
+    D_AR2SQ,
+    D_C1,
+    D_C2,
+    D_CM1,
+    D_CM2,
+    D_D10,
+    D_D20,
+    D_DYN,
+    D_F1,
+    D_F2,
+    D_FB0,
+    D_FBL,
+    D_K1,
+    D_K2,
+    D_KB1,
+    D_KB2,
+    D_MP,
+    D_NSEG,
+    D_OSC,
+    D_REAL,
+    D_RELAX,
+    D_SIG0,
+    D_SIG1,
+    D_SIGP,
+    D_SL,
+    D_SS_ON,
+    D_ST1,
+    D_ST2,
+    D_T0,
+    D_W1,
+    D_W2,
+    D_ZONES,
+    E_H,
+    E_ON,
+    E_OSC,
+    E_RATE,
+    E_RIM,
+    E_W,
+    I_DEPTH,
+    I_F,
+    I_HP,
+    I_LBASE,
+    I_LOFF,
+    I_SLACKT,
+    I_U,
+    I_V,
+    N_ROW,
+    NY,
+    P_DAMP,
+    P_FRICTION_N,
+    P_GRAVITY_N,
+    P_MASS,
+    P_PRELOAD,
+    P_PROJ,
+    P_STIFF,
+    P_VREG,
+    R_DRIVE_SPAN,
+    R_FIBRE_LEN,
+    R_FREE_SPAN,
+    R_G_PERP_WEIGHT_SPAN,
+    R_GRAVITY,
+    R_LIN_DENSITY,
+    R_PI_J,
+    R_PI_LOAD,
+    R_PI_ON,
+    R_PI_PRESLIDE,
+    R_PI_TORQUE,
+    R_PJ_DEPTH,
+    R_PJ_DWELL,
+    R_PJ_ON,
+    R_PJ_ONSET,
+    R_PJ_SEATS,
+    R_PJ_STEP,
+    R_RADIUS,
+    R_SIN_BETA,
+    R_SIN_HALF_WRAP,
+    R_SL_MU,
+    R_SL_ON,
+    R_SS_EXP,
+    R_SS_ON,
+    R_SS_RATIO,
+    R_SS_SIGMA,
+    R_SS_VS,
+    R_TV_LOAD,
+    R_TV_ON,
+    R_TV_TILT,
+    R_TV_ZETA,
+    R_VE_K,
+    R_VE_ON,
+    R_VE_TAU,
+    R_X_ON,
+    S_DEPTH,
+    S_LBASE,
+    S_LOFF,
+    S_PS0,
+    S_PZ,
+    S_RECSEAT,
+    S_SLACKT,
+    S_TAUT1,
+    S_TAUT2,
+    S_ZONE,
+    Y_A1,
+    Y_A2,
+    Y_AD1,
+    Y_AD2,
+    Y_Q1,
+    Y_Q2,
+    Y_S,
+    Y_SD,
+    Y_U,
+    Y_V,
+    Y_Z,
+)  # fmt: skip
 
-(Y_U, Y_V, Y_S, Y_SD, Y_Q1, Y_Q2, Y_A1, Y_AD1, Y_A2, Y_AD2, Y_Z) = range(11)
-NY = 11
+# Which terms the set composes (1: in): a term that is out is pruned at compile time.
+ON_VE, ON_TV, ON_PJ, ON_PI, ON_SS, ON_SL, ON_X, ON_ANY = 1, 1, 1, 1, 1, 1, 1, 1
+# </layout>
+
+# <state>: ``kernel_source.state_block`` writes the set's tuple helpers here; what follows
+# is the union's (a test holds them equal), for reading: this file never runs as itself.
 ZERO = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+NCARRY = 5  # states carried from segment to segment
+
+
+@njit(cache=True, error_model="numpy")
+def _axpy(y, a, k):  # type: ignore[no-untyped-def]
+    """y + a·k, component by component."""
+    return (
+        y[0] + a * k[0], y[1] + a * k[1], y[2] + a * k[2], y[3] + a * k[3], y[4] + a * k[4],
+        y[5] + a * k[5], y[6] + a * k[6], y[7] + a * k[7], y[8] + a * k[8], y[9] + a * k[9],
+        y[10] + a * k[10],
+    )  # fmt: skip
+
+
+@njit(cache=True, error_model="numpy")
+def _combine(y, a, k1, k2, k3, k4):  # type: ignore[no-untyped-def]
+    """The RK4 update y + a·(k1 + 2k2 + 2k3 + k4), component by component."""
+    return (
+        y[0] + a * (k1[0] + 2.0 * k2[0] + 2.0 * k3[0] + k4[0]),
+        y[1] + a * (k1[1] + 2.0 * k2[1] + 2.0 * k3[1] + k4[1]),
+        y[2] + a * (k1[2] + 2.0 * k2[2] + 2.0 * k3[2] + k4[2]),
+        y[3] + a * (k1[3] + 2.0 * k2[3] + 2.0 * k3[3] + k4[3]),
+        y[4] + a * (k1[4] + 2.0 * k2[4] + 2.0 * k3[4] + k4[4]),
+        y[5] + a * (k1[5] + 2.0 * k2[5] + 2.0 * k3[5] + k4[5]),
+        y[6] + a * (k1[6] + 2.0 * k2[6] + 2.0 * k3[6] + k4[6]),
+        y[7] + a * (k1[7] + 2.0 * k2[7] + 2.0 * k3[7] + k4[7]),
+        y[8] + a * (k1[8] + 2.0 * k2[8] + 2.0 * k3[8] + k4[8]),
+        y[9] + a * (k1[9] + 2.0 * k2[9] + 2.0 * k3[9] + k4[9]),
+        y[10] + a * (k1[10] + 2.0 * k2[10] + 2.0 * k3[10] + k4[10]),
+    )
+
+
+@njit(cache=True, error_model="numpy")
+def _hermite(a, b, d, e, h, y0, f0, y1, f1):  # type: ignore[no-untyped-def]
+    """The cubic Hermite interpolant's state from its four weights."""
+    return (
+        a * y0[0] + b * h * f0[0] + d * y1[0] + e * h * f1[0],
+        a * y0[1] + b * h * f0[1] + d * y1[1] + e * h * f1[1],
+        a * y0[2] + b * h * f0[2] + d * y1[2] + e * h * f1[2],
+        a * y0[3] + b * h * f0[3] + d * y1[3] + e * h * f1[3],
+        a * y0[4] + b * h * f0[4] + d * y1[4] + e * h * f1[4],
+        a * y0[5] + b * h * f0[5] + d * y1[5] + e * h * f1[5],
+        a * y0[6] + b * h * f0[6] + d * y1[6] + e * h * f1[6],
+        a * y0[7] + b * h * f0[7] + d * y1[7] + e * h * f1[7],
+        a * y0[8] + b * h * f0[8] + d * y1[8] + e * h * f1[8],
+        a * y0[9] + b * h * f0[9] + d * y1[9] + e * h * f1[9],
+        a * y0[10] + b * h * f0[10] + d * y1[10] + e * h * f1[10],
+    )
+
+
+@njit(cache=True, error_model="numpy")
+def _tuple_of(state):  # type: ignore[no-untyped-def]
+    """The state tuple from its array."""
+    return (
+        state[0], state[1], state[2], state[3], state[4], state[5], state[6], state[7],
+        state[8], state[9], state[10],
+    )  # fmt: skip
+
+
+@njit(cache=True, error_model="numpy")
+def _state(u, v, s, sd, q1, q2, a1, ad1, a2, ad2, z):  # type: ignore[no-untyped-def]
+    """The set's state from every state's value (those it lacks are dropped)."""
+    return (u, v, s, sd, q1, q2, a1, ad1, a2, ad2, z)
+
+
+@njit(cache=True, error_model="numpy")
+def _stiff_set(y, sd, z):  # type: ignore[no-untyped-def]
+    """y with the rim's velocity and the bristle replaced."""
+    return (y[0], y[1], y[2], sd, y[4], y[5], y[6], y[7], y[8], y[9], z)
+
+
+@njit(cache=True, error_model="numpy")
+def _carry_out(state, carried):  # type: ignore[no-untyped-def]
+    """The carried states of a state array."""
+    carried[0] = state[6]
+    carried[1] = state[7]
+    carried[2] = state[8]
+    carried[3] = state[9]
+    carried[4] = state[10]
+
+
+@njit(cache=True, error_model="numpy")
+def _with_carried(y, carried):  # type: ignore[no-untyped-def]
+    """y with the carried states replaced."""
+    return (
+        y[0], y[1], y[2], y[3], y[4], y[5], carried[0], carried[1], carried[2], carried[3],
+        carried[4],
+    )  # fmt: skip
+
+
+# </state>
+
 NSUB_MAX = 64  # substeps per sample interval at most
 EXP_COST = 1.3  # an exponential step (_etdrk4) costs about this many RK4 steps (measured)
 MAX_SWITCH = 8  # regime switches per segment located inside one step (the baseline's 8)
@@ -86,7 +277,7 @@ BRISTLE_SWING = 0.1  # relative change of the bristle's relaxation rate within o
 
 @njit(cache=True, error_model="numpy")
 def _mu(speed, c):  # type: ignore[no-untyped-def]
-    """μ(speed) from the PCHIP pieces (as sim.kernel._mu, the table read from c)."""
+    """μ(speed) from the PCHIP table in c; the end pieces extend smoothly past the knots."""
     n = int(c[C_TABLE])
     kn = C_TABLE + 1
     co = kn + n
@@ -116,7 +307,8 @@ def _zone(v, c):  # type: ignore[no-untyped-def]
 
 @njit(cache=True, error_model="numpy")
 def _friction(v, zone, c):  # type: ignore[no-untyped-def]
-    # The baseline's law with its branch held for the whole step (see sim.kernel).
+    # The branch is fixed for the whole step (an RK stage may stray just past v_reg): each
+    # branch is smooth, and the switch between branches is an event like the slack one.
     fn = c[P_FRICTION_N]
     if fn == 0.0:
         return 0.0
@@ -224,8 +416,8 @@ def pack(row, knots, coef):  # type: ignore[no-untyped-def]
 @njit(cache=True, error_model="numpy")
 def rest_state(c):  # type: ignore[no-untyped-def]
     """Static rest: weight and pulley still, fibre taut at T₀, strings at their gravity sag."""
-    if c[R_TV_ON] > 0.0:
-        return (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, c[D_AR1], 0.0, c[D_AR2], 0.0, 0.0)
+    if ON_TV and c[R_TV_ON] > 0.0:
+        return _state(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, c[D_AR1], 0.0, c[D_AR2], 0.0, 0.0)
     return ZERO
 
 
@@ -234,32 +426,33 @@ def _segments(c, y, xa, xb, xd):  # type: ignore[no-untyped-def]
     """(δ₁, F₁, δ₂, F₂, δ̇₁, δ̇₂): each segment's elongation and tension law at x = xa + xb."""
     n = c[P_PROJ]
     ext1, rate1, ext2, rate2 = 0.0, 0.0, 0.0, 0.0
-    if c[R_TV_ON] > 0.0:
+    if ON_TV and c[R_TV_ON] > 0.0:
         a1, a2 = y[Y_A1], y[Y_A2]
         ext1 = c[D_ST1] * (a1 * a1 - c[D_AR1SQ])
         rate1 = 2.0 * c[D_ST1] * a1 * y[Y_AD1]
         ext2 = c[D_ST2] * (a2 * a2 - c[D_AR2SQ])
         rate2 = 2.0 * c[D_ST2] * a2 * y[Y_AD2]
-    if c[R_PJ_ON] > 0.0:
+    if ON_PJ and c[R_PJ_ON] > 0.0:
         ext2 += c[S_LOFF]
-    if c[D_NSEG] < 1.5:
+    q1, q2 = (y[Y_Q1], y[Y_Q2]) if ON_VE else (0.0, 0.0)  # + 0.0: the union's sum
+    if not ON_PI or c[D_NSEG] < 1.5:
         d = c[D_D10] + xa + xb - n * y[Y_U] + (ext1 + ext2)
         dd = xd - n * y[Y_V] + (rate1 + rate2)
-        f = c[D_K1] * d + c[D_C1] * dd + y[Y_Q1]
+        f = c[D_K1] * d + c[D_C1] * dd + q1
         return d, f, d, f, dd, dd
     d1 = c[D_D10] + xa + xb - y[Y_S] + ext1
     dd1 = xd - y[Y_SD] + rate1
     d2 = c[D_D20] + y[Y_S] - n * y[Y_U] + ext2
     dd2 = y[Y_SD] - n * y[Y_V] + rate2
-    f1 = c[D_K1] * d1 + c[D_C1] * dd1 + y[Y_Q1]
-    f2 = c[D_K2] * d2 + c[D_C2] * dd2 + y[Y_Q2]
+    f1 = c[D_K1] * d1 + c[D_C1] * dd1 + q1
+    f2 = c[D_K2] * d2 + c[D_C2] * dd2 + q2
     return d1, f1, d2, f2, dd1, dd2
 
 
 @njit(cache=True, error_model="numpy")
 def _tensions(c, sg):  # type: ignore[no-untyped-def]
     t1 = sg[1] if c[S_TAUT1] > 0.0 else 0.0
-    if c[D_NSEG] < 1.5:
+    if not ON_PI or c[D_NSEG] < 1.5:
         return t1, t1
     return t1, (sg[3] if c[S_TAUT2] > 0.0 else 0.0)
 
@@ -270,7 +463,7 @@ def _bearing_limit(c, t1, t2):  # type: ignore[no-untyped-def]
     return (c[D_FB0] + c[D_FBL] * (max(t1, 0.0) + max(t2, 0.0))) / c[D_SIGP]
 
 
-# <added-force>: ``sim.effects._compose`` replaces this function in a composed kernel by
+# <added-force>: ``sim.physics.compose`` replaces this function in a composed kernel by
 # the sum of the added effects' forces; in this file no effect is added.
 @njit(cache=True, error_model="numpy")
 def _added_force(c, y, t2):  # type: ignore[no-untyped-def]
@@ -298,70 +491,45 @@ def _rhs(c, y, xa, xd):  # type: ignore[no-untyped-def]
     v = y[Y_V]
     zone = int(c[S_ZONE])
     zd = 0.0
-    if c[D_SS_ON] > 0.0:  # LuGre replaces the table's friction
+    if ON_SS and c[D_SS_ON] > 0.0:  # LuGre replaces the table's friction
         shape = _stribeck(v, c)
         g = c[P_FRICTION_N] * _mu(abs(v), c) * (1.0 + c[R_SS_RATIO] * shape)
         zd = v - c[D_SIG0] * abs(v) * y[Y_Z] / g
         fric = c[D_SIG0] * y[Y_Z] + c[D_SIG1] * shape * zd
     else:
         fric = _friction(v, zone, c)
-    if c[R_SL_ON] > 0.0:
+    if ON_SL and c[R_SL_ON] > 0.0:
         side = c[D_SL] * max(t2, 0.0)
         fric += side * zone if zone != 0 else side * v / c[P_VREG]
     drive = -c[P_GRAVITY_N] - fric
     drive += c[P_PROJ] * t2  # + 0.0 while slack: the baseline's sum, bit for bit
-    if c[R_X_ON] > 0.0:
+    if ON_X and c[R_X_ON] > 0.0:
         drive += _added_force(c, y, t2)
     acc = drive / c[P_MASS]
     s_acc, dq1, dq2, aa1, aa2 = 0.0, 0.0, 0.0, 0.0, 0.0
-    if c[D_NSEG] > 1.5:
+    if ON_PI and c[D_NSEG] > 1.5:
         fp = 0.0
         if c[D_SIGP] > 0.0:
             zmax = _bearing_limit(c, t1, t2)
             fp = c[D_SIGP] * min(max(c[S_PZ] + y[Y_S] - c[S_PS0], -zmax), zmax)
         s_acc = (t1 - t2 - fp) / c[D_MP]
-    if c[R_VE_ON] > 0.0:
+    if ON_VE and c[R_VE_ON] > 0.0:
         dq1 = (c[D_KB1] * sg[4] if c[S_TAUT1] > 0.0 else 0.0) - c[D_RELAX] * y[Y_Q1]
         if c[D_NSEG] > 1.5:
             dq2 = (c[D_KB2] * sg[5] if c[S_TAUT2] > 0.0 else 0.0) - c[D_RELAX] * y[Y_Q2]
-    if c[R_TV_ON] > 0.0:
+    if ON_TV and c[R_TV_ON] > 0.0:
         aa1 = c[D_F1] - c[D_W1] * max(t1, 0.0) * y[Y_A1] - c[D_CM1] * y[Y_AD1]
         aa2 = c[D_F2] - c[D_W2] * max(t2, 0.0) * y[Y_A2] - c[D_CM2] * y[Y_AD2]
-    return (v, acc, y[Y_SD], s_acc, dq1, dq2, y[Y_AD1], aa1, y[Y_AD2], aa2, zd)
-
-
-@njit(cache=True, error_model="numpy")
-def _axpy(y, a, k):  # type: ignore[no-untyped-def]
-    return (
-        y[0] + a * k[0], y[1] + a * k[1], y[2] + a * k[2], y[3] + a * k[3], y[4] + a * k[4],
-        y[5] + a * k[5], y[6] + a * k[6], y[7] + a * k[7], y[8] + a * k[8], y[9] + a * k[9],
-        y[10] + a * k[10],
-    )  # fmt: skip
-
-
-@njit(cache=True, error_model="numpy")
-def _combine(y, a, k1, k2, k3, k4):  # type: ignore[no-untyped-def]
-    """The RK4 update y + a·(k1 + 2k2 + 2k3 + k4), component by component."""
-    return (
-        y[0] + a * (k1[0] + 2.0 * k2[0] + 2.0 * k3[0] + k4[0]),
-        y[1] + a * (k1[1] + 2.0 * k2[1] + 2.0 * k3[1] + k4[1]),
-        y[2] + a * (k1[2] + 2.0 * k2[2] + 2.0 * k3[2] + k4[2]),
-        y[3] + a * (k1[3] + 2.0 * k2[3] + 2.0 * k3[3] + k4[3]),
-        y[4] + a * (k1[4] + 2.0 * k2[4] + 2.0 * k3[4] + k4[4]),
-        y[5] + a * (k1[5] + 2.0 * k2[5] + 2.0 * k3[5] + k4[5]),
-        y[6] + a * (k1[6] + 2.0 * k2[6] + 2.0 * k3[6] + k4[6]),
-        y[7] + a * (k1[7] + 2.0 * k2[7] + 2.0 * k3[7] + k4[7]),
-        y[8] + a * (k1[8] + 2.0 * k2[8] + 2.0 * k3[8] + k4[8]),
-        y[9] + a * (k1[9] + 2.0 * k2[9] + 2.0 * k3[9] + k4[9]),
-        y[10] + a * (k1[10] + 2.0 * k2[10] + 2.0 * k3[10] + k4[10]),
-    )
+    sd = y[Y_SD] if ON_PI else 0.0
+    ad1, ad2 = (y[Y_AD1], y[Y_AD2]) if ON_TV else (0.0, 0.0)
+    return _state(v, acc, sd, s_acc, dq1, dq2, ad1, aa1, ad2, aa2, zd)
 
 
 @njit(cache=True, error_model="numpy")
 def _rk4(c, y, x0, xd, h):  # type: ignore[no-untyped-def]
     """One RK4 step of length h from y: (new state, dy/dt at the start)."""
     k1 = _rhs(c, y, x0, xd)
-    if c[E_ON] > 0.0:
+    if ON_ANY and c[E_ON] > 0.0:
         return _etdrk4(c, y, x0, xd, h, k1), k1
     xm = x0 + 0.5 * h * xd
     k2 = _rhs(c, _axpy(y, 0.5 * h, k1), xm, xd)
@@ -436,12 +604,6 @@ def _rim_weights(c, rate, h):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True, error_model="numpy")
-def _stiff_set(y, sd, z):  # type: ignore[no-untyped-def]
-    """y with the rim's velocity and the bristle replaced."""
-    return (y[0], y[1], y[2], sd, y[4], y[5], y[6], y[7], y[8], y[9], z)
-
-
-@njit(cache=True, error_model="numpy")
 def _etdrk4(c, y, x0, xd, h, k1):  # type: ignore[no-untyped-def]
     """RK4 with the rim's velocity and the bristle by exponential time differencing.
 
@@ -488,19 +650,7 @@ def _switch_fn(c, theta, y0, f0, y1, f1, x0, xd, h, which, j):  # type: ignore[n
     if which >= 2:
         v = a * y0[Y_V] + b * h * f0[Y_V] + d * y1[Y_V] + e * h * f1[Y_V]
         return v - c[P_VREG] if which == 2 else v + c[P_VREG]
-    yi = (
-        a * y0[0] + b * h * f0[0] + d * y1[0] + e * h * f1[0],
-        a * y0[1] + b * h * f0[1] + d * y1[1] + e * h * f1[1],
-        a * y0[2] + b * h * f0[2] + d * y1[2] + e * h * f1[2],
-        a * y0[3] + b * h * f0[3] + d * y1[3] + e * h * f1[3],
-        a * y0[4] + b * h * f0[4] + d * y1[4] + e * h * f1[4],
-        a * y0[5] + b * h * f0[5] + d * y1[5] + e * h * f1[5],
-        a * y0[6] + b * h * f0[6] + d * y1[6] + e * h * f1[6],
-        a * y0[7] + b * h * f0[7] + d * y1[7] + e * h * f1[7],
-        a * y0[8] + b * h * f0[8] + d * y1[8] + e * h * f1[8],
-        a * y0[9] + b * h * f0[9] + d * y1[9] + e * h * f1[9],
-        a * y0[10] + b * h * f0[10] + d * y1[10] + e * h * f1[10],
-    )
+    yi = _hermite(a, b, d, e, h, y0, f0, y1, f1)
     sg = _segments(c, yi, x0, xd * theta * h, xd)
     return sg[2 * j] if which == 0 else sg[2 * j + 1]
 
@@ -533,12 +683,12 @@ def _set_taut(c, y, x, xd):  # type: ignore[no-untyped-def]
 @njit(cache=True, error_model="numpy")
 def _after_part(c, y, x, xd, h):  # type: ignore[no-untyped-def]
     """Update the discrete states at the end of an integrated part (h seconds) of a step."""
-    if c[D_NSEG] > 1.5 and c[D_SIGP] > 0.0:  # bearing presliding (elasto-plastic)
+    if ON_PI and c[D_NSEG] > 1.5 and c[D_SIGP] > 0.0:  # bearing presliding (elasto-plastic)
         t1, t2 = _tensions(c, _segments(c, y, x, 0.0, xd))
         zmax = _bearing_limit(c, t1, t2)
         c[S_PZ] = min(max(c[S_PZ] + y[Y_S] - c[S_PS0], -zmax), zmax)
         c[S_PS0] = y[Y_S]
-    if c[R_PJ_ON] > 0.0 and c[S_RECSEAT] == 0.0:
+    if ON_PJ and c[R_PJ_ON] > 0.0 and c[S_RECSEAT] == 0.0:
         # The weight-side segment carries the seat (one segment: S_TAUT2 is only
         # refreshed at a step's start; S_TAUT1 follows every located switch).
         taut = c[S_TAUT2] if c[D_NSEG] > 1.5 else c[S_TAUT1]
@@ -578,8 +728,8 @@ def _reseat(c, slack, elongation, h):  # type: ignore[no-untyped-def]
 
 @njit(cache=True, error_model="numpy")
 def _step(c, y, x0, xd, h):  # type: ignore[no-untyped-def]
-    """Advance y by h, splitting the step at every regime switch (as sim.kernel._step)."""
-    nseg = 2 if c[D_NSEG] > 1.5 else 1
+    """Advance y by h, splitting the step at every regime switch ."""
+    nseg = 2 if ON_PI and c[D_NSEG] > 1.5 else 1
     remaining = h
     xs = x0
     _set_taut(c, y, xs, xd)  # ẋ, and c·δ̇, step at sample boundaries
@@ -644,7 +794,7 @@ def _substeps(c, y, x, xd, dt, base):  # type: ignore[no-untyped-def]
     (c[E_ON] says which this interval takes).
     """
     c[E_ON] = 0.0
-    if c[D_DYN] <= 0.0:
+    if not ON_ANY or c[D_DYN] <= 0.0:
         return base
     sg = _segments(c, y, x, 0.0, xd)
     t_est = 1.5 * max(sg[1], sg[3], 0.0) + c[D_T0]
@@ -691,7 +841,7 @@ def _sample_out(c, y, x, xd, i, out_u, out_v, out_t1, out_t2):  # type: ignore[n
     t1 = sg[1] if c[S_TAUT1] > 0.0 else 0.0
     out_t1[i] = t1 if t1 > 0.0 else 0.0
     t2 = t1
-    if c[D_NSEG] > 1.5:
+    if ON_PI and c[D_NSEG] > 1.5:
         t2 = sg[3] if c[S_TAUT2] > 0.0 else 0.0
     out_t2[i] = t2 if t2 > 0.0 else 0.0
 
@@ -716,12 +866,9 @@ def _advance(x, dt, substeps, c, state, out_u, out_v, out_t1, out_t2, seat):  # 
     seat[i + 1], the episodes up to sample i read. Without, the seat follows the model's
     own slack (``_after_part``).
     """
-    y = (
-        state[0], state[1], state[2], state[3], state[4], state[5], state[6], state[7],
-        state[8], state[9], state[10],
-    )  # fmt: skip
+    y = _tuple_of(state)
     c[S_ZONE] = _zone(y[Y_V], c)
-    recorded = seat.shape[0] >= x.shape[0] and c[R_PJ_ON] > 0.0
+    recorded = ON_PJ and seat.shape[0] >= x.shape[0] and c[R_PJ_ON] > 0.0
     c[S_RECSEAT] = 1.0 if recorded else 0.0
     most = 0
     for i in range(x.shape[0] - 1):
@@ -753,7 +900,7 @@ def _from_rest(x, dt, substeps, row, knots, coef, out_u, out_v, out_t1, out_t2, 
     y = rest_state(c)
     out_u[0] = y[Y_U]
     out_v[0] = y[Y_V]
-    out_t1[0] = c[D_K1] * (c[D_D10] + x[0])  # as sim.kernel: unclamped, no rate term
+    out_t1[0] = c[D_K1] * (c[D_D10] + x[0])  # unclamped, no rate term (as always)
     out_t2[0] = out_t1[0] if c[D_NSEG] < 1.5 else c[D_K2] * c[D_D20]
     state = np.empty(NY)
     for k in range(NY):
@@ -769,12 +916,6 @@ def simulate_batch_into(x, dt, substeps, rows, knots, coef, out_u, out_v, out_t1
         simulate_into(
             xb, dt, substeps, rows[b], knots, coef, out_u[b], out_v[b], out_t1[b], out_t2[b]
         )
-
-
-# Measured start state of a segment (``simulate_segments_into``): columns of init[b, s].
-# I_FRATE: the recorded force's rate (the force gauge filter's state, ``measure``).
-(I_U, I_V, I_F, I_HP, I_LOFF, I_LBASE, I_DEPTH, I_SLACKT, I_FRATE) = range(9)
-N_INIT = 9
 
 
 @njit(cache=True, error_model="numpy")
@@ -824,7 +965,7 @@ def measured_state(c, x, xd, m):  # type: ignore[no-untyped-def]
     n = c[P_PROJ]
     taut = force > 0.25 * c[D_T0]
     s, sd = 0.0, 0.0
-    if c[D_NSEG] > 1.5:
+    if ON_PI and c[D_NSEG] > 1.5:
         k1, k2 = c[D_K1], c[D_K2]
         sd = (k1 * xd + k2 * n * v) / (k1 + k2)
         if taut:
@@ -832,11 +973,11 @@ def measured_state(c, x, xd, m):  # type: ignore[no-untyped-def]
         else:
             s = (k1 * (c[D_D10] + x) - k2 * (c[D_D20] - n * u)) / (k1 + k2)
     a1, a2 = 0.0, 0.0
-    if c[R_TV_ON] > 0.0:
+    if ON_TV and c[R_TV_ON] > 0.0:
         scale = c[D_T0] / force if taut else 1.0
         a1, a2 = c[D_AR1] * scale, c[D_AR2] * scale
     z = 0.0
-    if c[D_SS_ON] > 0.0:
+    if ON_SS and c[D_SS_ON] > 0.0:
         g = c[P_FRICTION_N] * _mu(abs(v), c) * (1.0 + c[R_SS_RATIO] * _stribeck(v, c))
         limit = g / c[D_SIG0]
         if abs(v) > c[R_SS_VS]:
@@ -844,10 +985,10 @@ def measured_state(c, x, xd, m):  # type: ignore[no-untyped-def]
         else:
             z = min(max((n * max(force, 0.0) - c[P_GRAVITY_N]) / c[D_SIG0], -limit), limit)
     q1, q2 = c[D_KB1] * m[I_HP], c[D_KB2] * m[I_HP]
-    y = (u, v, s, sd, q1, q2, a1, 0.0, a2, 0.0, z)
+    y = _state(u, v, s, sd, q1, q2, a1, 0.0, a2, 0.0, z)
     c[S_LOFF], c[S_LBASE], c[S_DEPTH], c[S_SLACKT] = m[I_LOFF], m[I_LBASE], m[I_DEPTH], m[I_SLACKT]
     c[S_PZ], c[S_PS0] = 0.0, s
-    if c[D_NSEG] > 1.5 and c[D_SIGP] > 0.0:
+    if ON_PI and c[D_NSEG] > 1.5 and c[D_SIGP] > 0.0:
         _set_taut(c, y, x, xd)
         t1, t2 = _tensions(c, _segments(c, y, x, 0.0, xd))
         zmax = _bearing_limit(c, t1, t2)
@@ -887,7 +1028,7 @@ def _chain_into(  # type: ignore[no-untyped-def]
 ):
     """Row b of ``simulate_chained_into``: its segments one after the other."""
     segs = starts.shape[0]
-    carried = np.zeros(NY - Y_A1)
+    carried = np.zeros(NCARRY)
     have = False
     for s in range(segs):
         n = lens[s]
@@ -905,10 +1046,7 @@ def _chain_into(  # type: ignore[no-untyped-def]
         else:
             y = measured_state(c, xs[0], xd, init[b, s])
             if have:
-                y = (
-                    y[0], y[1], y[2], y[3], y[4], y[5],
-                    carried[0], carried[1], carried[2], carried[3], carried[4],
-                )  # fmt: skip
+                y = _with_carried(y, carried)
             _set_taut(c, y, xs[0], xd)
             _sample_out(c, y, xs[0], xd, 0, ou, sv, ot, st2)
         state = np.empty(NY)
@@ -920,8 +1058,7 @@ def _chain_into(  # type: ignore[no-untyped-def]
             _advance(
                 xs[:h1], dt, substeps, c, state, ou[:h1], sv[:h1], ot[:h1], st2[:h1], seat[:h1]
             )
-            for k in range(NY - Y_A1):
-                carried[k] = state[Y_A1 + k]
+            _carry_out(state, carried)
             have = True
             tail = slice(hand, n)
             _advance(

@@ -1,0 +1,84 @@
+"""The kernel's source as text, its marked blocks, and the state block for a set of terms.
+
+``kernel.py`` marks three blocks (``# <name>`` … ``# </name>``) that ``compose`` writes
+for each set: the layout's constants, the state's tuple helpers (this module writes
+them: numba builds a tuple only from an expression of fixed length, so each set gets
+its own) and the added effects' forces. The helpers' arithmetic is the same for every
+set, component by component, so a state's value never depends on which others exist.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from sim.physics import layout
+
+__all__ = ["splice", "state_block", "text"]
+
+_NJIT = '@njit(cache=True, error_model="numpy")'
+
+
+def text() -> str:
+    """The kernel's source (``sim/physics/kernel.py``)."""
+    return (Path(__file__).parent / "kernel.py").read_text(encoding="utf-8")
+
+
+def splice(source: str, name: str, block: str) -> str:
+    """``source`` with its block ``name`` (from its opening marker to its closing one) replaced."""
+    start = source.index(f"# <{name}>")
+    end = source.index(f"# </{name}>")
+    return source[:start] + block + source[end:]
+
+
+def block(source: str, name: str) -> str:
+    """The block ``name`` of ``source`` as ``splice`` replaces it."""
+    return source[source.index(f"# <{name}>") : source.index(f"# </{name}>")]
+
+
+def state_block(terms: tuple[str, ...]) -> str:
+    """The tuple helpers for the states of a set of terms (``layout.state_names``)."""
+    names = layout.state_names(terms)
+    n = len(names)
+    at = {name: i for i, name in enumerate(names)}
+    every = [name for name, _ in layout.STATES]
+    carried = [at[name] for name in layout.CARRIED if name in at]
+
+    def tup(items: list[str]) -> str:
+        return "(" + ", ".join(items) + ("," if len(items) == 1 else "") + ")"
+
+    def func(signature: str, doc: str, body: list[str]) -> list[str]:
+        return ["", "", _NJIT, f"def {signature}:  # type: ignore[no-untyped-def]",
+                f'    """{doc}"""', *body]  # fmt: skip
+
+    lines = [
+        f"# <state>: written by ``kernel_source.state_block`` for the states {', '.join(names)}.",
+        f"ZERO = {tup(['0.0'] * n)}",
+        f"NCARRY = {len(carried)}  # states carried from segment to segment",
+    ]
+    lines += func("_axpy(y, a, k)", "y + a·k, component by component.",
+                  [f"    return {tup([f'y[{i}] + a * k[{i}]' for i in range(n)])}"])  # fmt: skip
+    rk4 = [f"y[{i}] + a * (k1[{i}] + 2.0 * k2[{i}] + 2.0 * k3[{i}] + k4[{i}])" for i in range(n)]
+    lines += func("_combine(y, a, k1, k2, k3, k4)",
+                  "The RK4 update y + a·(k1 + 2k2 + 2k3 + k4), component by component.",
+                  [f"    return {tup(rk4)}"])  # fmt: skip
+    herm = [f"a * y0[{i}] + b * h * f0[{i}] + d * y1[{i}] + e * h * f1[{i}]" for i in range(n)]
+    lines += func("_hermite(a, b, d, e, h, y0, f0, y1, f1)",
+                  "The cubic Hermite interpolant's state from its four weights.",
+                  [f"    return {tup(herm)}"])  # fmt: skip
+    lines += func("_tuple_of(state)", "The state tuple from its array.",
+                  [f"    return {tup([f'state[{i}]' for i in range(n)])}"])  # fmt: skip
+    lines += func(f"_state({', '.join(name.lower() for name in every)})",
+                  "The set's state from every state's value (those it lacks are dropped).",
+                  [f"    return {tup([name.lower() for name in names])}"])  # fmt: skip
+    stiff = [
+        "sd" if name == "SD" else "z" if name == "Z" else f"y[{i}]" for i, name in enumerate(names)
+    ]
+    lines += func("_stiff_set(y, sd, z)", "y with the rim's velocity and the bristle replaced.",
+                  [f"    return {tup(stiff)}"])  # fmt: skip
+    out = [f"    carried[{j}] = state[{i}]" for j, i in enumerate(carried)] or ["    return"]
+    lines += func("_carry_out(state, carried)", "The carried states of a state array.", out)
+    where = {i: j for j, i in enumerate(carried)}
+    back = [f"carried[{where[i]}]" if i in where else f"y[{i}]" for i in range(n)]
+    lines += func("_with_carried(y, carried)", "y with the carried states replaced.",
+                  [f"    return {tup(back)}"])  # fmt: skip
+    return "\n".join(lines) + "\n\n\n"

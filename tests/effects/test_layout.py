@@ -1,0 +1,71 @@
+"""Where everything sits is computed from the registry's order, and reading it loads no numba."""
+
+from __future__ import annotations
+
+import ast
+import subprocess
+import sys
+
+import numpy as np
+
+from sim.config import StandConfig
+from sim.effects import EFFECTS
+from sim.physics import compose, kernel_source, layout
+from sim.physics.runs import friction_arrays, parameter_row
+
+
+def test_reading_the_effects_and_their_columns_loads_no_numba() -> None:
+    code = (
+        "import sys\n"
+        "from sim.effects import EFFECTS, parse_effect\n"
+        "spec = parse_effect('fibre_pulley_jump:onset_m=0.001')\n"
+        "print(EFFECTS[spec.name].param('onset_m').column, 'numba' in sys.modules)\n"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, check=True, timeout=120
+    )
+    column, numba = out.stdout.split()
+    assert int(column) == layout.R_PJ_ONSET
+    assert numba == "False"
+
+
+def test_the_row_follows_the_registry_order_effect_by_effect() -> None:
+    expected = layout.STAND_COLUMNS
+    for info in EFFECTS.values():
+        if info.weight_force is not None:
+            continue  # added with register: in the block from R_X
+        assert info.flag_column == expected
+        assert [p.column for p in info.params] == list(
+            range(expected + 1, expected + 1 + len(info.params))
+        )
+        assert getattr(layout, f"R_{info.symbol}_ON") == info.flag_column
+        for p in info.params:  # the kernel's name for each parameter is its column
+            assert getattr(layout, f"R_{info.symbol}_{p.symbol}") == p.column
+        expected += 1 + len(info.params)
+    assert expected == layout.R_X_ON
+    assert layout.N_ROW == layout.R_X + layout.N_X
+    # The constants array continues where the row ends, nothing numbered twice.
+    after = sorted(v for k, v in layout.constants((), False).items() if k[:2] in ("D_", "S_", "E_"))
+    assert after[0] == layout.N_ROW
+    assert len(set(after)) == len(after)
+    assert max(after) < layout.C_TABLE
+
+
+def test_the_kernels_own_state_block_is_what_compose_writes_for_the_union() -> None:
+    # The file shows the union's tuple helpers; a composed kernel runs the written ones.
+    text = kernel_source.text()
+    written = kernel_source.state_block(layout.TERMS)
+    shown = kernel_source.block(text, "state")
+    assert ast.dump(ast.parse(shown)) == ast.dump(ast.parse(written))
+
+
+def test_the_baseline_has_two_states_and_the_union_every_terms(stand: StandConfig) -> None:
+    p = stand.stand_params("final", 8.131)
+    c_args = (parameter_row(p), *friction_arrays(p.friction))
+    base, union = compose.baseline(), compose.union()
+    assert len(base.rest_state(base.pack(*c_args))) == 2
+    assert len(union.rest_state(union.pack(*c_args))) == len(layout.STATES)
+    assert layout.state_names(()) == ("U", "V")
+    # Different sets, different files: a set's machine code is never another's.
+    assert base.__name__ != union.__name__
+    assert np.array_equal(base.pack(*c_args), union.pack(*c_args))
