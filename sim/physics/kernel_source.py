@@ -1,10 +1,11 @@
-"""The kernel's source as text, its marked blocks, and the state block for a set of terms.
+"""The model's source as text, its marked blocks, and the state block for a set of terms.
 
-``kernel.py`` marks three blocks (``# <name>`` … ``# </name>``) that ``compose`` writes
-for each set: the layout's constants, the state's tuple helpers (this module writes
-them: numba builds a tuple only from an expression of fixed length, so each set gets
-its own) and the added effects' forces. The helpers' arithmetic is the same for every
-set, component by component, so a state's value never depends on which others exist.
+The head ``kernel.py`` and its parts mark three blocks (``# <name>`` … ``# </name>``)
+that ``compose`` writes for each set: the layout's constants, the state's tuple helpers
+(this module writes them: numba builds a tuple only from an expression of fixed length,
+so each set gets its own) and the added effects' forces. The helpers' arithmetic is the
+same for every set, component by component, so a state's value never depends on which
+others exist.
 """
 
 from __future__ import annotations
@@ -18,9 +19,18 @@ __all__ = ["splice", "state_block", "text"]
 _NJIT = '@njit(cache=True, error_model="numpy")'
 
 
+#: The parts of the model's text after its head (``kernel.py``), in order.
+PARTS = ("fibre.py", "integrator.py", "runners.py")
+
+
 def text() -> str:
-    """The kernel's source (``sim/physics/kernel.py``)."""
-    return (Path(__file__).parent / "kernel.py").read_text(encoding="utf-8")
+    """The model's whole text: the head, then each part without its import block."""
+    here = Path(__file__).parent
+    texts = [(here / "kernel.py").read_text(encoding="utf-8")]
+    for name in PARTS:
+        part = (here / name).read_text(encoding="utf-8")
+        texts.append(part.split("# </imports>\n", 1)[1])
+    return "\n".join(texts)
 
 
 def splice(source: str, name: str, block: str) -> str:

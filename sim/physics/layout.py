@@ -20,8 +20,6 @@ from dataclasses import replace
 from sim.effects.builtin import BUILT_IN
 from sim.effects.info import EffectInfo
 
-__all__ = ["N_ROW", "PLACED", "STATES", "constants", "place", "state_names"]
-
 # The baseline's parameters (``sim.physics.runs.param_vector``), then the stand geometry.
 (P_MASS, P_PROJ, P_STIFF, P_DAMP, P_FRICTION_N, P_GRAVITY_N, P_PRELOAD, P_VREG) = range(8)
 (R_DRIVE_SPAN, R_FREE_SPAN, R_FIBRE_LEN, R_LIN_DENSITY, R_SIN_BETA, R_G_PERP_WEIGHT_SPAN,

@@ -1,0 +1,329 @@
+"""The runners: from rest, a batch, segments from measured starts, chained, block by block.
+
+A part of the compiled model's text, never run as itself (``kernel.py`` says how it is
+composed). One set of runners for every set of terms: the baseline's are these with no
+terms composed in.
+"""
+
+from __future__ import annotations
+
+# <imports>
+import numpy as np
+from numba import njit, prange
+
+from sim.physics.fibre import (
+    _bearing_limit,
+    _mu,
+    _reseat,
+    _sample_out,
+    _segments,
+    _set_taut,
+    _stribeck,
+    _tensions,
+    _zone,
+    pack,
+    rest_state,
+)
+from sim.physics.integrator import _step, _substeps
+from sim.physics.kernel import (
+    NCARRY,
+    ON_PI,
+    ON_PJ,
+    ON_SS,
+    ON_TV,
+    _carry_out,
+    _state,
+    _tuple_of,
+    _with_carried,
+)
+from sim.physics.layout import *
+
+# </imports>
+
+
+@njit(cache=True, error_model="numpy")
+def advance_into(x, dt, substeps, c, state, out_u, out_v, out_t1, out_t2):  # type: ignore[no-untyped-def]
+    """Integrate from the state (array of NY; discrete part in c) at x[0] over x[1:].
+
+    Writes u, v and the drive- and weight-side tensions after each sample into
+    out_*[i + 1] and the final state back into ``state`` and c, so a run can go on block
+    by block. Returns the largest number of substeps one interval took.
+    """
+    return _advance(x, dt, substeps, c, state, out_u, out_v, out_t1, out_t2, np.empty(0))
+
+
+@njit(cache=True, error_model="numpy")
+def _advance(x, dt, substeps, c, state, out_u, out_v, out_t1, out_t2, seat):  # type: ignore[no-untyped-def]
+    """``advance_into``; with ``seat`` (one per sample of x) the pulley seat's offset.
+
+    A seat given is the one the *recorded* slack episodes put the fibre in
+    (``measured_seats`` at every sample): over the interval after sample i the seat is
+    seat[i + 1], the episodes up to sample i read. Without, the seat follows the model's
+    own slack (``_after_part``).
+    """
+    y = _tuple_of(state)
+    c[S_ZONE] = _zone(y[Y_V], c)
+    recorded = ON_PJ and seat.shape[0] >= x.shape[0] and c[R_PJ_ON] > 0.0
+    c[S_RECSEAT] = 1.0 if recorded else 0.0
+    most = 0
+    for i in range(x.shape[0] - 1):
+        xd = (x[i + 1] - x[i]) / dt
+        if recorded:
+            c[S_LOFF] = seat[i + 1]
+        nsub = _substeps(c, y, x[i], xd, dt, substeps)
+        most = max(most, nsub)
+        h = dt / nsub
+        for j in range(nsub):
+            y = _step(c, y, x[i] + xd * j * h, xd, h)
+        _sample_out(c, y, x[i + 1], xd, i + 1, out_u, out_v, out_t1, out_t2)
+    for k in range(NY):
+        state[k] = y[k]
+    c[S_RECSEAT] = 0.0
+    return most
+
+
+@njit(cache=True, error_model="numpy")
+def simulate_into(x, dt, substeps, row, knots, coef, out_u, out_v, out_t1, out_t2):  # type: ignore[no-untyped-def]
+    """Integrate one parameter row from static rest over the drive samples x (relative)."""
+    return _from_rest(x, dt, substeps, row, knots, coef, out_u, out_v, out_t1, out_t2, np.empty(0))
+
+
+@njit(cache=True, error_model="numpy")
+def _from_rest(x, dt, substeps, row, knots, coef, out_u, out_v, out_t1, out_t2, seat):  # type: ignore[no-untyped-def]
+    """``simulate_into``, the seat given as in ``_advance``."""
+    c = pack(row, knots, coef)
+    y = rest_state(c)
+    out_u[0] = y[Y_U]
+    out_v[0] = y[Y_V]
+    out_t1[0] = c[D_K1] * (c[D_D10] + x[0])  # unclamped, no rate term (as always)
+    out_t2[0] = out_t1[0] if c[D_NSEG] < 1.5 else c[D_K2] * c[D_D20]
+    state = np.empty(NY)
+    for k in range(NY):
+        state[k] = y[k]
+    return _advance(x, dt, substeps, c, state, out_u, out_v, out_t1, out_t2, seat)
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def simulate_batch_into(x, dt, substeps, rows, knots, coef, out_u, out_v, out_t1, out_t2):  # type: ignore[no-untyped-def]
+    """simulate_into for each row (and row of x, unless x has one row), in parallel."""
+    for b in prange(rows.shape[0]):
+        xb = x[b] if x.shape[0] > 1 else x[0]
+        simulate_into(
+            xb, dt, substeps, rows[b], knots, coef, out_u[b], out_v[b], out_t1[b], out_t2[b]
+        )
+
+
+@njit(cache=True, error_model="numpy")
+def measured_seats(row, x, u, force, dt, slack_n, starts):  # type: ignore[no-untyped-def]
+    """The pulley seat (I_LOFF … I_SLACKT) at each start, from the recorded episodes.
+
+    ``_reseat``'s law driven by the recorded slack (force below ``slack_n``) and the
+    recorded geometry (x relative to rest, u on the model's scale), from the seat at
+    rest. Which groove the fibre sits in is not observable at a restart, but every slack
+    episode that moved it is in the recording; a simulated seat, carried from segment to
+    segment, follows the *model's* slack episodes instead, and one episode too short
+    or too long in a chaotic bounce puts every later seat in the wrong groove.
+    """
+    c = np.zeros(C_TABLE)
+    for i in range(N_ROW):
+        c[i] = row[i]
+    out = np.zeros((starts.shape[0], 4))
+    k = 0
+    for j in range(starts.shape[0]):
+        while k < starts[j]:
+            _reseat(c, force[k] < slack_n, c[P_PRELOAD] + x[k] - c[P_PROJ] * u[k], dt)
+            k += 1
+        out[j, 0], out[j, 1], out[j, 2], out[j, 3] = c[S_LOFF], c[S_LBASE], c[S_DEPTH], c[S_SLACKT]
+    return out
+
+
+@njit(cache=True, error_model="numpy")
+def measured_state(c, x, xd, m):  # type: ignore[no-untyped-def]
+    """A full state from a measured start m (columns I_*) at drive x (m), rate xd (m/s).
+
+    Measured: weight u (m), v (m/s) and the drive-side force F (N). The effects' own
+    states are not measured and take quasi-static values: pulley rim where the drive-side
+    segment carries the measured F (taut) or both segments equal tension (slack), moving
+    with the fibre, bearing presliding holding the tension difference (within its limit);
+    Maxwell branches at k₂·hp, hp the elongation high-passed with τ (the branch's response
+    to the measured history, computed by the caller); string modes at their static sag
+    for the measured tension (rest sag while slack; ``simulate_chained_into`` replaces
+    them by the previous segment's); LuGre bristle holding the measured
+    force balance n·F − m·g·sin α, limited to (and, faster than v_s, at) its sliding
+    value; pulley-jump seat from the recorded slack episodes (``measured_seats``, in
+    m's I_LOFF … I_SLACKT; a seat estimated from the measured elongation at the start,
+    rounded to one of the two grooves, picked the wrong groove often enough to cost 340×
+    the open-loop error on a clean recording).
+    Sets the discrete state in c; returns the continuous state tuple.
+    """
+    u, v, force = m[I_U], m[I_V], m[I_F]
+    n = c[P_PROJ]
+    taut = force > 0.25 * c[D_T0]
+    s, sd = 0.0, 0.0
+    if ON_PI and c[D_NSEG] > 1.5:
+        k1, k2 = c[D_K1], c[D_K2]
+        sd = (k1 * xd + k2 * n * v) / (k1 + k2)
+        if taut:
+            s = c[D_D10] + x - (force - c[D_C1] * (xd - sd)) / k1
+        else:
+            s = (k1 * (c[D_D10] + x) - k2 * (c[D_D20] - n * u)) / (k1 + k2)
+    a1, a2 = 0.0, 0.0
+    if ON_TV and c[R_TV_ON] > 0.0:
+        scale = c[D_T0] / force if taut else 1.0
+        a1, a2 = c[D_AR1] * scale, c[D_AR2] * scale
+    z = 0.0
+    if ON_SS and c[D_SS_ON] > 0.0:
+        g = c[P_FRICTION_N] * _mu(abs(v), c) * (1.0 + c[R_SS_RATIO] * _stribeck(v, c))
+        limit = g / c[D_SIG0]
+        if abs(v) > c[R_SS_VS]:
+            z = limit if v > 0.0 else -limit
+        else:
+            z = min(max((n * max(force, 0.0) - c[P_GRAVITY_N]) / c[D_SIG0], -limit), limit)
+    q1, q2 = c[D_KB1] * m[I_HP], c[D_KB2] * m[I_HP]
+    y = _state(u, v, s, sd, q1, q2, a1, 0.0, a2, 0.0, z)
+    c[S_LOFF], c[S_LBASE], c[S_DEPTH], c[S_SLACKT] = m[I_LOFF], m[I_LBASE], m[I_DEPTH], m[I_SLACKT]
+    c[S_PZ], c[S_PS0] = 0.0, s
+    if ON_PI and c[D_NSEG] > 1.5 and c[D_SIGP] > 0.0:
+        _set_taut(c, y, x, xd)
+        t1, t2 = _tensions(c, _segments(c, y, x, 0.0, xd))
+        zmax = _bearing_limit(c, t1, t2)
+        c[S_PZ] = min(max((t1 - t2) / c[D_SIGP], -zmax), zmax)
+    return y
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def simulate_chained_into(  # type: ignore[no-untyped-def]
+    x, dt, substeps, rows, knots, coef, starts, lens, init, out_u, out_t1, seats
+):
+    """``simulate_segments_into`` segment after segment per row (parallel over rows only).
+
+    The string modes and the LuGre bristle are not observable from the gauges at a start
+    (a ringing span's phase; the bristle's pre-sliding while sticking), but they are
+    driven by the tension and the weight's motion: simulating them is their observer. So
+    every segment after the first starts them where the previous segment's run had them
+    at that sample; everything else starts from ``measured_state`` as before (the pulley
+    seat from the recorded slack episodes, ``measured_seats``).
+    """
+    for b in prange(rows.shape[0]):
+        _chain_into(b, x, dt, substeps, rows, knots, coef, starts, lens, init, out_u, out_t1, seats)
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def simulate_chained_serial(  # type: ignore[no-untyped-def]
+    x, dt, substeps, rows, knots, coef, starts, lens, init, out_u, out_t1, seats
+):
+    """``simulate_chained_into`` on the calling thread, without the GIL (traces side by side)."""
+    for b in range(rows.shape[0]):
+        _chain_into(b, x, dt, substeps, rows, knots, coef, starts, lens, init, out_u, out_t1, seats)
+
+
+@njit(cache=True, error_model="numpy")
+def _chain_into(  # type: ignore[no-untyped-def]
+    b, x, dt, substeps, rows, knots, coef, starts, lens, init, out_u, out_t1, seats
+):
+    """Row b of ``simulate_chained_into``: its segments one after the other."""
+    segs = starts.shape[0]
+    carried = np.zeros(NCARRY)
+    have = False
+    for s in range(segs):
+        n = lens[s]
+        xs = x[starts[s] : starts[s] + n]
+        ou, ot = out_u[b, s], out_t1[b, s]
+        seat = seats[b, starts[s] : starts[s] + n]  # empty: the model's own slack
+        sv, st2 = np.empty(n), np.empty(n)
+        c = pack(rows[b], knots, coef)
+        xd = (xs[1] - xs[0]) / dt if n > 1 else 0.0
+        if starts[s] == 0:
+            y = rest_state(c)
+            ou[0], sv[0] = y[Y_U], y[Y_V]
+            ot[0] = c[D_K1] * (c[D_D10] + xs[0])
+            st2[0] = ot[0]
+        else:
+            y = measured_state(c, xs[0], xd, init[b, s])
+            if have:
+                y = _with_carried(y, carried)
+            _set_taut(c, y, xs[0], xd)
+            _sample_out(c, y, xs[0], xd, 0, ou, sv, ot, st2)
+        state = np.empty(NY)
+        for k in range(NY):
+            state[k] = y[k]
+        hand = starts[s + 1] - starts[s] if s + 1 < segs else n
+        if 0 < hand < n:
+            h1 = hand + 1
+            _advance(
+                xs[:h1], dt, substeps, c, state, ou[:h1], sv[:h1], ot[:h1], st2[:h1], seat[:h1]
+            )
+            _carry_out(state, carried)
+            have = True
+            tail = slice(hand, n)
+            _advance(
+                xs[tail], dt, substeps, c, state, ou[tail], sv[tail], ot[tail], st2[tail],
+                seat[tail],
+            )  # fmt: skip
+        elif n > 1:
+            _advance(xs, dt, substeps, c, state, ou, sv, ot, st2, seat)
+        for i in range(n, ou.shape[0]):
+            ou[i] = ou[n - 1]
+            ot[i] = ot[n - 1]
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def simulate_segments_into(  # type: ignore[no-untyped-def]
+    x, dt, substeps, rows, knots, coef, starts, lens, init, out_u, out_t1, seats
+):
+    """Many short runs (segments) of many rows, in parallel over (set, segment).
+
+    Segment s covers samples starts[s] … starts[s] + lens[s] − 1 of the relative drive
+    x. A segment at sample 0 starts from static rest (as ``simulate_into``); any other
+    from ``measured_state`` of init[b, s] (columns I_*). Writes u and the drive-side
+    tension into out_*[b, s, :lens[s]], the last value held to the end of the row.
+    seats[b] (one per sample of x, or none): the pulley seat the runs hold (``_advance``).
+    """
+    segs = starts.shape[0]
+    for flat in prange(rows.shape[0] * segs):
+        _segment_into(
+            flat // segs, flat % segs, x, dt, substeps, rows, knots, coef, starts, lens, init,
+            out_u, out_t1, seats,
+        )  # fmt: skip
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def simulate_segments_serial(  # type: ignore[no-untyped-def]
+    x, dt, substeps, rows, knots, coef, starts, lens, init, out_u, out_t1, seats
+):
+    """``simulate_segments_into`` on the calling thread, without the GIL (traces side by side)."""
+    segs = starts.shape[0]
+    for flat in range(rows.shape[0] * segs):
+        _segment_into(
+            flat // segs, flat % segs, x, dt, substeps, rows, knots, coef, starts, lens, init,
+            out_u, out_t1, seats,
+        )  # fmt: skip
+
+
+@njit(cache=True, error_model="numpy")
+def _segment_into(  # type: ignore[no-untyped-def]
+    b, s, x, dt, substeps, rows, knots, coef, starts, lens, init, out_u, out_t1, seats
+):
+    """Segment s of row b of ``simulate_segments_into``."""
+    n = lens[s]
+    xs = x[starts[s] : starts[s] + n]
+    ou = out_u[b, s]
+    ot = out_t1[b, s]
+    seat = seats[b, starts[s] : starts[s] + n]  # empty: the model's own slack
+    sv, st2 = np.empty(n), np.empty(n)
+    if starts[s] == 0:
+        _from_rest(xs, dt, substeps, rows[b], knots, coef, ou, sv, ot, st2, seat)
+    else:
+        c = pack(rows[b], knots, coef)
+        xd = (xs[1] - xs[0]) / dt if n > 1 else 0.0
+        y = measured_state(c, xs[0], xd, init[b, s])
+        _set_taut(c, y, xs[0], xd)
+        _sample_out(c, y, xs[0], xd, 0, ou, sv, ot, st2)
+        state = np.empty(NY)
+        for k in range(NY):
+            state[k] = y[k]
+        if n > 1:
+            _advance(xs, dt, substeps, c, state, ou, sv, ot, st2, seat)
+    for i in range(n, ou.shape[0]):
+        ou[i] = ou[n - 1]
+        ot[i] = ot[n - 1]
