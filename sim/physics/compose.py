@@ -91,7 +91,7 @@ def _composed(terms: tuple[str, ...], added: tuple[EffectInfo, ...]) -> ModuleTy
 
 def source_for(terms: tuple[str, ...], added: tuple[EffectInfo, ...] = ()) -> str:
     """The kernel's source composed for a set: its three marked blocks written for it."""
-    text = kernel_source.text()
+    text = kernel_source.text(terms)
     names = ", ".join(terms + tuple(info.name for info in added)) or "none (the baseline)"
     values = layout.constants(terms, bool(added))
     head = [
@@ -102,6 +102,7 @@ def source_for(terms: tuple[str, ...], added: tuple[EffectInfo, ...] = ()) -> st
     ]
     text = kernel_source.splice(text, "layout", "\n".join(head))
     text = kernel_source.splice(text, "state", kernel_source.state_block(terms))
+    text = kernel_source.splice(text, "hooks", kernel_source.hooks_block(terms))
     return kernel_source.splice(text, "added-force", _added_block(added))
 
 

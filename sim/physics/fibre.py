@@ -14,7 +14,21 @@ import math
 import numpy as np
 from numba import njit
 
-from sim.physics.kernel import ON_PI, ON_PJ, ON_SL, ON_SS, ON_TV, ON_VE, ON_X, ZERO, _state
+from sim.physics.kernel import (
+    ON_PI,
+    ON_SS,
+    ON_TV,
+    ON_VE,
+    ON_X,
+    ZERO,
+    _state,
+    _terms_after_part,
+    _terms_extension,
+    _terms_friction,
+    _terms_on,
+    _terms_pack,
+    _terms_zoned,
+)
 from sim.physics.layout import *
 
 # </imports>
@@ -146,13 +160,12 @@ def pack(row, knots, coef):  # type: ignore[no-untyped-def]
         g_peak = c[P_FRICTION_N] * _mu(v_peak, c) * (1.0 + c[R_SS_RATIO] * shape)
         coupled = c[D_SIG1] * shape * c[R_SS_SIGMA] * v_peak / g_peak - c[R_SS_SIGMA]
         c[E_OSC] = max(osc, 2.0 * math.sqrt(max(coupled, 0.0) / c[P_MASS]))
-    if c[R_SL_ON] > 0.0:
-        c[D_SL] = c[R_SL_MU] * c[R_SIN_BETA]
+    _terms_pack(c)
     c[D_OSC], c[D_REAL] = osc, real
-    on = c[R_VE_ON] + c[R_TV_ON] + c[R_PJ_ON] + c[R_PI_ON] + c[R_SS_ON] + c[R_SL_ON] + c[R_X_ON]
+    on = c[R_VE_ON] + c[R_TV_ON] + c[R_PI_ON] + c[R_SS_ON] + c[R_X_ON] + _terms_on(c)
     c[D_DYN] = 1.0 if on > 0.0 else 0.0
     table = c[P_FRICTION_N] != 0.0 and c[D_SS_ON] == 0.0
-    c[D_ZONES] = 1.0 if table or c[R_SL_ON] > 0.0 else 0.0
+    c[D_ZONES] = 1.0 if table or _terms_zoned(c) else 0.0
     c[S_TAUT1], c[S_TAUT2] = 1.0, 1.0
     c[E_H] = -1.0  # no rim weights yet
     return c
@@ -177,8 +190,7 @@ def _segments(c, y, xa, xb, xd):  # type: ignore[no-untyped-def]
         rate1 = 2.0 * c[D_ST1] * a1 * y[Y_AD1]
         ext2 = c[D_ST2] * (a2 * a2 - c[D_AR2SQ])
         rate2 = 2.0 * c[D_ST2] * a2 * y[Y_AD2]
-    if ON_PJ and c[R_PJ_ON] > 0.0:
-        ext2 += c[S_LOFF]
+    ext1, rate1, ext2, rate2 = _terms_extension(c, y, ext1, rate1, ext2, rate2)
     q1, q2 = (y[Y_Q1], y[Y_Q2]) if ON_VE else (0.0, 0.0)  # + 0.0: the union's sum
     if not ON_PI or c[D_NSEG] < 1.5:
         d = c[D_D10] + xa + xb - n * y[Y_U] + (ext1 + ext2)
@@ -243,9 +255,7 @@ def _rhs(c, y, xa, xd):  # type: ignore[no-untyped-def]
         fric = c[D_SIG0] * y[Y_Z] + c[D_SIG1] * shape * zd
     else:
         fric = _friction(v, zone, c)
-    if ON_SL and c[R_SL_ON] > 0.0:
-        side = c[D_SL] * max(t2, 0.0)
-        fric += side * zone if zone != 0 else side * v / c[P_VREG]
+    fric = _terms_friction(c, v, zone, t2, fric)
     drive = -c[P_GRAVITY_N] - fric
     drive += c[P_PROJ] * t2  # + 0.0 while slack: the baseline's sum, bit for bit
     if ON_X and c[R_X_ON] > 0.0:
@@ -286,42 +296,7 @@ def _after_part(c, y, x, xd, h):  # type: ignore[no-untyped-def]
         zmax = _bearing_limit(c, t1, t2)
         c[S_PZ] = min(max(c[S_PZ] + y[Y_S] - c[S_PS0], -zmax), zmax)
         c[S_PS0] = y[Y_S]
-    if ON_PJ and c[R_PJ_ON] > 0.0 and c[S_RECSEAT] == 0.0:
-        # The weight-side segment carries the seat (one segment: S_TAUT2 is only
-        # refreshed at a step's start; S_TAUT1 follows every located switch).
-        taut = c[S_TAUT2] if c[D_NSEG] > 1.5 else c[S_TAUT1]
-        _reseat(c, taut <= 0.0, c[P_PRELOAD] + x - c[P_PROJ] * y[Y_U], h)
-
-
-@njit(cache=True, error_model="numpy")
-def _reseat(c, slack, elongation, h):  # type: ignore[no-untyped-def]
-    """The pulley seat after h seconds more of a slack (or taut) fibre.
-
-    The fibre leaves its groove once its loop is ``onset`` deep and has lain slack for
-    ``dwell`` (held by groove friction, it needs time to slide out), and has moved over to
-    the next seat within a few depth scales more: with ``seats`` = 0 the other of two
-    grooves (it toggles), else one more step up the groove's flank, up to ``seats`` steps
-    (the flange), where it stays. The seat follows the episode's deepest geometric slack,
-    so it never moves back within one episode; when the fibre is taut again it stays where
-    it is. The same law runs on the model's slack (``_after_part``) and on the recorded
-    one (``measured_seats``).
-    """
-    if slack:
-        c[S_SLACKT] += h
-        c[S_DEPTH] = max(c[S_DEPTH], -(elongation + c[S_LBASE]))
-        if c[S_SLACKT] >= c[R_PJ_DWELL]:
-            base, step = c[S_LBASE], c[R_PJ_STEP]
-            seats = math.floor(c[R_PJ_SEATS] + 0.5)
-            if seats < 1 or step == 0.0:
-                target = step if abs(base) <= abs(base - step) else 0.0  # the other seat
-            else:  # one step further up the flank, at most ``seats`` steps
-                target = min(math.floor(base / step + 0.5) + 1.0, seats) * step
-            beyond = max(0.0, c[S_DEPTH] - c[R_PJ_ONSET])
-            c[S_LOFF] = base + (target - base) * (1.0 - math.exp(-beyond / c[R_PJ_DEPTH]))
-    elif c[S_SLACKT] > 0.0:  # the episode is over: the fibre stays in its new seat
-        c[S_LBASE] = c[S_LOFF]
-        c[S_DEPTH] = 0.0
-        c[S_SLACKT] = 0.0
+    _terms_after_part(c, y, x, xd, h)
 
 
 @njit(cache=True, error_model="numpy")

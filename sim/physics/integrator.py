@@ -34,6 +34,7 @@ from sim.physics.kernel import (
     _combine,
     _hermite,
     _stiff_set,
+    _terms_substeps,
 )
 from sim.physics.layout import *
 
@@ -264,8 +265,7 @@ def _substeps(c, y, x, xd, dt, base):  # type: ignore[no-untyped-def]
     if c[R_TV_ON] > 0.0 and strings > 0.0:  # an unexcited string mode stays exactly zero
         modes = math.sqrt(max(c[D_W1], c[D_W2]) * t_est) + c[D_CM1] + c[D_CM2]
         osc, osc_exp = max(osc, modes), max(osc_exp, modes)
-    if c[R_SL_ON] > 0.0:
-        real = max(real, c[D_SL] * t_est / (c[P_VREG] * c[P_MASS]))
+    real = _terms_substeps(c, t_est, real)
     real_exp = real
     real = max(real, c[E_RIM])
     if c[D_SS_ON] > 0.0:

@@ -157,6 +157,96 @@ def _with_carried(y, carried):  # type: ignore[no-untyped-def]
 
 # </state>
 
+# <hooks>: ``kernel_source.hooks_block`` writes the composed terms' hook calls here; what
+# follows is the union's (a test holds them equal), for reading and linting.
+from sim.effects.fibre_pulley_jump.terms import (
+    pj_after_part,
+    pj_extension,
+    pj_given_at,
+    pj_given_end,
+    pj_given_start,
+    pj_start,
+)
+from sim.effects.side_load_friction.terms import sl_friction, sl_pack, sl_substeps, sl_zoned
+
+
+@njit(cache=True, error_model="numpy")
+def _terms_on(c):  # type: ignore[no-untyped-def]
+    """How many of the composed terms are on (> 0: any)."""
+    return 0.0 + c[R_PJ_ON] + c[R_SL_ON]
+
+
+@njit(cache=True, error_model="numpy")
+def _terms_pack(c):  # type: ignore[no-untyped-def]
+    """The composed terms' ``pack`` hooks."""
+    sl_pack(c)
+
+
+@njit(cache=True, error_model="numpy")
+def _terms_zoned(c):  # type: ignore[no-untyped-def]
+    """The composed terms' ``zoned`` hooks."""
+    said = False
+    this = sl_zoned(c)
+    said = said or this
+    return said
+
+
+@njit(cache=True, error_model="numpy")
+def _terms_extension(c, y, ext1, rate1, ext2, rate2):  # type: ignore[no-untyped-def]
+    """The composed terms' ``extension`` hooks."""
+    ext1, rate1, ext2, rate2 = pj_extension(c, y, ext1, rate1, ext2, rate2)
+    return ext1, rate1, ext2, rate2
+
+
+@njit(cache=True, error_model="numpy")
+def _terms_friction(c, v, zone, t2, fric):  # type: ignore[no-untyped-def]
+    """The composed terms' ``friction`` hooks."""
+    fric = sl_friction(c, v, zone, t2, fric)
+    return fric
+
+
+@njit(cache=True, error_model="numpy")
+def _terms_substeps(c, t_est, real):  # type: ignore[no-untyped-def]
+    """The composed terms' ``substeps`` hooks."""
+    real = sl_substeps(c, t_est, real)
+    return real
+
+
+@njit(cache=True, error_model="numpy")
+def _terms_after_part(c, y, x, xd, h):  # type: ignore[no-untyped-def]
+    """The composed terms' ``after_part`` hooks."""
+    pj_after_part(c, y, x, xd, h)
+
+
+@njit(cache=True, error_model="numpy")
+def _terms_given_start(c, given):  # type: ignore[no-untyped-def]
+    """The composed terms' ``given_start`` hooks."""
+    said = False
+    this = pj_given_start(c, given)
+    said = said or this
+    return said
+
+
+@njit(cache=True, error_model="numpy")
+def _terms_given_at(c, value):  # type: ignore[no-untyped-def]
+    """The composed terms' ``given_at`` hooks."""
+    pj_given_at(c, value)
+
+
+@njit(cache=True, error_model="numpy")
+def _terms_given_end(c):  # type: ignore[no-untyped-def]
+    """The composed terms' ``given_end`` hooks."""
+    pj_given_end(c)
+
+
+@njit(cache=True, error_model="numpy")
+def _terms_start(c, m):  # type: ignore[no-untyped-def]
+    """The composed terms' ``start`` hooks."""
+    pj_start(c, m)
+
+
+# </hooks>
+
 NSUB_MAX = 64  # substeps per sample interval at most
 EXP_COST = 1.3  # an exponential step (_etdrk4) costs about this many RK4 steps (measured)
 MAX_SWITCH = 8  # regime switches per segment located inside one step (the baseline's 8)

@@ -10,11 +10,12 @@ others exist.
 
 from __future__ import annotations
 
+import ast
 from pathlib import Path
 
 from sim.physics import layout
 
-__all__ = ["splice", "state_block", "text"]
+__all__ = ["HOOKS", "hooks_block", "splice", "state_block", "term_files", "text"]
 
 _NJIT = '@njit(cache=True, error_model="numpy")'
 
@@ -23,14 +24,78 @@ _NJIT = '@njit(cache=True, error_model="numpy")'
 PARTS = ("fibre.py", "integrator.py", "runners.py")
 
 
-def text() -> str:
-    """The model's whole text: the head, then each part without its import block."""
+#: The hooks a term may define (``<symbol>_<hook>`` in its ``terms.py``), and how the
+#: composed set calls them in the registry's order: the arguments, then what each term
+#: passes on to the next and the last returns; None: a yes/no, yes if any term says so;
+#: (): called for its effect on c.
+HOOKS: dict[str, tuple[tuple[str, ...], tuple[str, ...] | None]] = {
+    "pack": (("c",), ()),  # derived constants into c
+    "zoned": (("c",), None),  # friction has the baseline's branches
+    "extension": (("c", "y", "ext1", "rate1", "ext2", "rate2"), ("ext1", "rate1", "ext2", "rate2")),
+    "friction": (("c", "v", "zone", "t2", "fric"), ("fric",)),  # guide friction, N
+    "substeps": (("c", "t_est", "real"), ("real",)),  # fastest decay, 1/s
+    "after_part": (("c", "y", "x", "xd", "h"), ()),  # discrete state after a part
+    "given_start": (("c", "given"), None),  # follows a recorded input this run
+    "given_at": (("c", "value"), ()),  # the input over the next interval
+    "given_end": (("c",), ()),
+    "start": (("c", "m"), ()),  # discrete state at a measured start
+}  # fmt: skip
+
+
+def term_files(terms: tuple[str, ...]) -> list[tuple[str, Path]]:
+    """(symbol, path) of the composed built-in terms that live in their effect's folder."""
+    effects = Path(__file__).parent.parent / "effects"
+    found = []
+    for info in layout.PLACED:
+        path = effects / info.name / "terms.py"
+        if info.symbol in terms and path.exists():
+            found.append((info.symbol, path))
+    return found
+
+
+def _body(path: Path) -> str:
+    return path.read_text(encoding="utf-8").split("# </imports>\n", 1)[1]
+
+
+def text(terms: tuple[str, ...] = layout.TERMS) -> str:
+    """The model's whole text: the head, each part, each composed term's file (no imports)."""
     here = Path(__file__).parent
     texts = [(here / "kernel.py").read_text(encoding="utf-8")]
-    for name in PARTS:
-        part = (here / name).read_text(encoding="utf-8")
-        texts.append(part.split("# </imports>\n", 1)[1])
+    texts += [_body(here / name) for name in PARTS]
+    texts += [_body(path) for _, path in term_files(terms)]
     return "\n".join(texts)
+
+
+def hooks_block(terms: tuple[str, ...]) -> str:
+    """``_terms_<hook>``: each hook of the composed terms' files, called in order."""
+    defined = {
+        symbol: {n.name for n in ast.parse(path.read_text(encoding="utf-8")).body
+                 if isinstance(n, ast.FunctionDef)}
+        for symbol, path in term_files(terms)
+    }  # fmt: skip
+    lines = [f"# <hooks>: written by ``kernel_source.hooks_block`` for: {', '.join(defined)}."]
+    flags = "".join(f" + c[R_{symbol}_ON]" for symbol in defined)
+    lines += ["", "", _NJIT, "def _terms_on(c):  # type: ignore[no-untyped-def]",
+              '    """How many of the composed terms are on (> 0: any)."""',
+              f"    return 0.0{flags}"]  # fmt: skip
+    for hook, (args, passed) in HOOKS.items():
+        calls = [f"{s.lower()}_{hook}" for s in defined if f"{s.lower()}_{hook}" in defined[s]]
+        call_args = ", ".join(args)
+        body = []
+        if passed is None:
+            body.append("    said = False")
+            for func in calls:
+                body += [f"    this = {func}({call_args})", "    said = said or this"]
+            body.append("    return said")
+        elif passed:
+            out = ", ".join(passed)
+            body += [f"    {out} = {func}({call_args})" for func in calls]
+            body.append(f"    return {out}")
+        else:
+            body += [f"    {func}({call_args})" for func in calls] or ["    return"]
+        lines += ["", "", _NJIT, f"def _terms_{hook}({call_args}):  # type: ignore[no-untyped-def]",
+                  f'    """The composed terms\' ``{hook}`` hooks."""', *body]  # fmt: skip
+    return "\n".join(lines) + "\n\n\n"
 
 
 def splice(source: str, name: str, block: str) -> str:

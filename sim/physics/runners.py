@@ -14,7 +14,6 @@ from numba import njit, prange
 from sim.physics.fibre import (
     _bearing_limit,
     _mu,
-    _reseat,
     _sample_out,
     _segments,
     _set_taut,
@@ -28,11 +27,14 @@ from sim.physics.integrator import _step, _substeps
 from sim.physics.kernel import (
     NCARRY,
     ON_PI,
-    ON_PJ,
     ON_SS,
     ON_TV,
     _carry_out,
     _state,
+    _terms_given_at,
+    _terms_given_end,
+    _terms_given_start,
+    _terms_start,
     _tuple_of,
     _with_carried,
 )
@@ -53,23 +55,23 @@ def advance_into(x, dt, substeps, c, state, out_u, out_v, out_t1, out_t2):  # ty
 
 
 @njit(cache=True, error_model="numpy")
-def _advance(x, dt, substeps, c, state, out_u, out_v, out_t1, out_t2, seat):  # type: ignore[no-untyped-def]
-    """``advance_into``; with ``seat`` (one per sample of x) the pulley seat's offset.
+def _advance(x, dt, substeps, c, state, out_u, out_v, out_t1, out_t2, inputs):  # type: ignore[no-untyped-def]
+    """``advance_into``; with ``inputs`` (one per sample of x) a term's recorded input.
 
-    A seat given is the one the *recorded* slack episodes put the fibre in
-    (``measured_seats`` at every sample): over the interval after sample i the seat is
-    seat[i + 1], the episodes up to sample i read. Without, the seat follows the model's
-    own slack (``_after_part``).
+    A term may follow a recorded input instead of its own law (the pulley jump: the seat
+    the *recorded* slack episodes put the fibre in, its ``measured_seats`` at every
+    sample): over the interval after sample i the term is given inputs[i + 1], the
+    recording up to sample i read (``_terms_given_*``). Without, the term follows the
+    model (the seat the model's own slack gives).
     """
     y = _tuple_of(state)
     c[S_ZONE] = _zone(y[Y_V], c)
-    recorded = ON_PJ and seat.shape[0] >= x.shape[0] and c[R_PJ_ON] > 0.0
-    c[S_RECSEAT] = 1.0 if recorded else 0.0
+    given = _terms_given_start(c, inputs.shape[0] >= x.shape[0])
     most = 0
     for i in range(x.shape[0] - 1):
         xd = (x[i + 1] - x[i]) / dt
-        if recorded:
-            c[S_LOFF] = seat[i + 1]
+        if given:
+            _terms_given_at(c, inputs[i + 1])
         nsub = _substeps(c, y, x[i], xd, dt, substeps)
         most = max(most, nsub)
         h = dt / nsub
@@ -78,7 +80,7 @@ def _advance(x, dt, substeps, c, state, out_u, out_v, out_t1, out_t2, seat):  # 
         _sample_out(c, y, x[i + 1], xd, i + 1, out_u, out_v, out_t1, out_t2)
     for k in range(NY):
         state[k] = y[k]
-    c[S_RECSEAT] = 0.0
+    _terms_given_end(c)
     return most
 
 
@@ -89,8 +91,8 @@ def simulate_into(x, dt, substeps, row, knots, coef, out_u, out_v, out_t1, out_t
 
 
 @njit(cache=True, error_model="numpy")
-def _from_rest(x, dt, substeps, row, knots, coef, out_u, out_v, out_t1, out_t2, seat):  # type: ignore[no-untyped-def]
-    """``simulate_into``, the seat given as in ``_advance``."""
+def _from_rest(x, dt, substeps, row, knots, coef, out_u, out_v, out_t1, out_t2, inputs):  # type: ignore[no-untyped-def]
+    """``simulate_into``, a term's input given as in ``_advance``."""
     c = pack(row, knots, coef)
     y = rest_state(c)
     out_u[0] = y[Y_U]
@@ -100,7 +102,7 @@ def _from_rest(x, dt, substeps, row, knots, coef, out_u, out_v, out_t1, out_t2, 
     state = np.empty(NY)
     for k in range(NY):
         state[k] = y[k]
-    return _advance(x, dt, substeps, c, state, out_u, out_v, out_t1, out_t2, seat)
+    return _advance(x, dt, substeps, c, state, out_u, out_v, out_t1, out_t2, inputs)
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
@@ -111,30 +113,6 @@ def simulate_batch_into(x, dt, substeps, rows, knots, coef, out_u, out_v, out_t1
         simulate_into(
             xb, dt, substeps, rows[b], knots, coef, out_u[b], out_v[b], out_t1[b], out_t2[b]
         )
-
-
-@njit(cache=True, error_model="numpy")
-def measured_seats(row, x, u, force, dt, slack_n, starts):  # type: ignore[no-untyped-def]
-    """The pulley seat (I_LOFF … I_SLACKT) at each start, from the recorded episodes.
-
-    ``_reseat``'s law driven by the recorded slack (force below ``slack_n``) and the
-    recorded geometry (x relative to rest, u on the model's scale), from the seat at
-    rest. Which groove the fibre sits in is not observable at a restart, but every slack
-    episode that moved it is in the recording; a simulated seat, carried from segment to
-    segment, follows the *model's* slack episodes instead, and one episode too short
-    or too long in a chaotic bounce puts every later seat in the wrong groove.
-    """
-    c = np.zeros(C_TABLE)
-    for i in range(N_ROW):
-        c[i] = row[i]
-    out = np.zeros((starts.shape[0], 4))
-    k = 0
-    for j in range(starts.shape[0]):
-        while k < starts[j]:
-            _reseat(c, force[k] < slack_n, c[P_PRELOAD] + x[k] - c[P_PROJ] * u[k], dt)
-            k += 1
-        out[j, 0], out[j, 1], out[j, 2], out[j, 3] = c[S_LOFF], c[S_LBASE], c[S_DEPTH], c[S_SLACKT]
-    return out
 
 
 @njit(cache=True, error_model="numpy")
@@ -181,7 +159,7 @@ def measured_state(c, x, xd, m):  # type: ignore[no-untyped-def]
             z = min(max((n * max(force, 0.0) - c[P_GRAVITY_N]) / c[D_SIG0], -limit), limit)
     q1, q2 = c[D_KB1] * m[I_HP], c[D_KB2] * m[I_HP]
     y = _state(u, v, s, sd, q1, q2, a1, 0.0, a2, 0.0, z)
-    c[S_LOFF], c[S_LBASE], c[S_DEPTH], c[S_SLACKT] = m[I_LOFF], m[I_LBASE], m[I_DEPTH], m[I_SLACKT]
+    _terms_start(c, m)
     c[S_PZ], c[S_PS0] = 0.0, s
     if ON_PI and c[D_NSEG] > 1.5 and c[D_SIGP] > 0.0:
         _set_taut(c, y, x, xd)
@@ -193,7 +171,7 @@ def measured_state(c, x, xd, m):  # type: ignore[no-untyped-def]
 
 @njit(cache=True, parallel=True, error_model="numpy")
 def simulate_chained_into(  # type: ignore[no-untyped-def]
-    x, dt, substeps, rows, knots, coef, starts, lens, init, out_u, out_t1, seats
+    x, dt, substeps, rows, knots, coef, starts, lens, init, out_u, out_t1, inputs
 ):
     """``simulate_segments_into`` segment after segment per row (parallel over rows only).
 
@@ -205,21 +183,25 @@ def simulate_chained_into(  # type: ignore[no-untyped-def]
     seat from the recorded slack episodes, ``measured_seats``).
     """
     for b in prange(rows.shape[0]):
-        _chain_into(b, x, dt, substeps, rows, knots, coef, starts, lens, init, out_u, out_t1, seats)
+        _chain_into(
+            b, x, dt, substeps, rows, knots, coef, starts, lens, init, out_u, out_t1, inputs
+        )
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
 def simulate_chained_serial(  # type: ignore[no-untyped-def]
-    x, dt, substeps, rows, knots, coef, starts, lens, init, out_u, out_t1, seats
+    x, dt, substeps, rows, knots, coef, starts, lens, init, out_u, out_t1, inputs
 ):
     """``simulate_chained_into`` on the calling thread, without the GIL (traces side by side)."""
     for b in range(rows.shape[0]):
-        _chain_into(b, x, dt, substeps, rows, knots, coef, starts, lens, init, out_u, out_t1, seats)
+        _chain_into(
+            b, x, dt, substeps, rows, knots, coef, starts, lens, init, out_u, out_t1, inputs
+        )
 
 
 @njit(cache=True, error_model="numpy")
 def _chain_into(  # type: ignore[no-untyped-def]
-    b, x, dt, substeps, rows, knots, coef, starts, lens, init, out_u, out_t1, seats
+    b, x, dt, substeps, rows, knots, coef, starts, lens, init, out_u, out_t1, inputs
 ):
     """Row b of ``simulate_chained_into``: its segments one after the other."""
     segs = starts.shape[0]
@@ -229,7 +211,7 @@ def _chain_into(  # type: ignore[no-untyped-def]
         n = lens[s]
         xs = x[starts[s] : starts[s] + n]
         ou, ot = out_u[b, s], out_t1[b, s]
-        seat = seats[b, starts[s] : starts[s] + n]  # empty: the model's own slack
+        given = inputs[b, starts[s] : starts[s] + n]  # empty: the model's own law
         sv, st2 = np.empty(n), np.empty(n)
         c = pack(rows[b], knots, coef)
         xd = (xs[1] - xs[0]) / dt if n > 1 else 0.0
@@ -251,17 +233,17 @@ def _chain_into(  # type: ignore[no-untyped-def]
         if 0 < hand < n:
             h1 = hand + 1
             _advance(
-                xs[:h1], dt, substeps, c, state, ou[:h1], sv[:h1], ot[:h1], st2[:h1], seat[:h1]
+                xs[:h1], dt, substeps, c, state, ou[:h1], sv[:h1], ot[:h1], st2[:h1], given[:h1]
             )
             _carry_out(state, carried)
             have = True
             tail = slice(hand, n)
             _advance(
                 xs[tail], dt, substeps, c, state, ou[tail], sv[tail], ot[tail], st2[tail],
-                seat[tail],
+                given[tail],
             )  # fmt: skip
         elif n > 1:
-            _advance(xs, dt, substeps, c, state, ou, sv, ot, st2, seat)
+            _advance(xs, dt, substeps, c, state, ou, sv, ot, st2, given)
         for i in range(n, ou.shape[0]):
             ou[i] = ou[n - 1]
             ot[i] = ot[n - 1]
@@ -269,7 +251,7 @@ def _chain_into(  # type: ignore[no-untyped-def]
 
 @njit(cache=True, parallel=True, error_model="numpy")
 def simulate_segments_into(  # type: ignore[no-untyped-def]
-    x, dt, substeps, rows, knots, coef, starts, lens, init, out_u, out_t1, seats
+    x, dt, substeps, rows, knots, coef, starts, lens, init, out_u, out_t1, inputs
 ):
     """Many short runs (segments) of many rows, in parallel over (set, segment).
 
@@ -277,42 +259,43 @@ def simulate_segments_into(  # type: ignore[no-untyped-def]
     x. A segment at sample 0 starts from static rest (as ``simulate_into``); any other
     from ``measured_state`` of init[b, s] (columns I_*). Writes u and the drive-side
     tension into out_*[b, s, :lens[s]], the last value held to the end of the row.
-    seats[b] (one per sample of x, or none): the pulley seat the runs hold (``_advance``).
+    inputs[b] (one per sample of x, or none): a term's recorded input the runs follow
+    (``_advance``: the pulley seat).
     """
     segs = starts.shape[0]
     for flat in prange(rows.shape[0] * segs):
         _segment_into(
             flat // segs, flat % segs, x, dt, substeps, rows, knots, coef, starts, lens, init,
-            out_u, out_t1, seats,
+            out_u, out_t1, inputs,
         )  # fmt: skip
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
 def simulate_segments_serial(  # type: ignore[no-untyped-def]
-    x, dt, substeps, rows, knots, coef, starts, lens, init, out_u, out_t1, seats
+    x, dt, substeps, rows, knots, coef, starts, lens, init, out_u, out_t1, inputs
 ):
     """``simulate_segments_into`` on the calling thread, without the GIL (traces side by side)."""
     segs = starts.shape[0]
     for flat in range(rows.shape[0] * segs):
         _segment_into(
             flat // segs, flat % segs, x, dt, substeps, rows, knots, coef, starts, lens, init,
-            out_u, out_t1, seats,
+            out_u, out_t1, inputs,
         )  # fmt: skip
 
 
 @njit(cache=True, error_model="numpy")
 def _segment_into(  # type: ignore[no-untyped-def]
-    b, s, x, dt, substeps, rows, knots, coef, starts, lens, init, out_u, out_t1, seats
+    b, s, x, dt, substeps, rows, knots, coef, starts, lens, init, out_u, out_t1, inputs
 ):
     """Segment s of row b of ``simulate_segments_into``."""
     n = lens[s]
     xs = x[starts[s] : starts[s] + n]
     ou = out_u[b, s]
     ot = out_t1[b, s]
-    seat = seats[b, starts[s] : starts[s] + n]  # empty: the model's own slack
+    given = inputs[b, starts[s] : starts[s] + n]  # empty: the model's own law
     sv, st2 = np.empty(n), np.empty(n)
     if starts[s] == 0:
-        _from_rest(xs, dt, substeps, rows[b], knots, coef, ou, sv, ot, st2, seat)
+        _from_rest(xs, dt, substeps, rows[b], knots, coef, ou, sv, ot, st2, given)
     else:
         c = pack(rows[b], knots, coef)
         xd = (xs[1] - xs[0]) / dt if n > 1 else 0.0
@@ -323,7 +306,7 @@ def _segment_into(  # type: ignore[no-untyped-def]
         for k in range(NY):
             state[k] = y[k]
         if n > 1:
-            _advance(xs, dt, substeps, c, state, ou, sv, ot, st2, seat)
+            _advance(xs, dt, substeps, c, state, ou, sv, ot, st2, given)
     for i in range(n, ou.shape[0]):
         ou[i] = ou[n - 1]
         ot[i] = ot[n - 1]

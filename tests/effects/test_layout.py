@@ -51,12 +51,27 @@ def test_the_row_follows_the_registry_order_effect_by_effect() -> None:
     assert max(after) < layout.C_TABLE
 
 
-def test_the_kernels_own_state_block_is_what_compose_writes_for_the_union() -> None:
-    # The file shows the union's tuple helpers; a composed kernel runs the written ones.
+def test_the_heads_own_blocks_are_what_compose_writes_for_the_union() -> None:
+    # The head shows the union's tuple helpers and hook calls (and imports the hooks, for
+    # linting); a composed model runs the written ones.
     text = kernel_source.text()
-    written = kernel_source.state_block(layout.TERMS)
-    shown = kernel_source.block(text, "state")
-    assert ast.dump(ast.parse(shown)) == ast.dump(ast.parse(written))
+    for name, written in (
+        ("state", kernel_source.state_block(layout.TERMS)),
+        ("hooks", kernel_source.hooks_block(layout.TERMS)),
+    ):
+        shown = ast.parse(kernel_source.block(text, name))
+        shown.body = [node for node in shown.body if not isinstance(node, ast.ImportFrom)]
+        assert ast.dump(shown) == ast.dump(ast.parse(written)), name
+
+
+def test_an_effects_terms_are_in_its_own_folder_and_only_where_composed() -> None:
+    files = dict(kernel_source.term_files(layout.TERMS))
+    assert files["PJ"].parent.name == "fibre_pulley_jump"
+    assert files["SL"].parent.name == "side_load_friction"
+    baseline = compose.source_for(())
+    assert "def pj_after_part" not in baseline and "def sl_friction" not in baseline
+    union = compose.source_for(layout.TERMS)
+    assert "def pj_after_part" in union and "pj_after_part(c, y, x, xd, h)" in union
 
 
 def test_the_baseline_has_two_states_and_the_union_every_terms(stand: StandConfig) -> None:
