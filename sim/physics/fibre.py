@@ -16,17 +16,17 @@ from numba import njit
 
 from sim.physics.kernel import (
     ON_PI,
-    ON_SS,
-    ON_TV,
-    ON_VE,
     ON_X,
-    ZERO,
-    _state,
     _terms_after_part,
+    _terms_branch,
     _terms_extension,
     _terms_friction,
+    _terms_friction_law,
     _terms_on,
     _terms_pack,
+    _terms_rates,
+    _terms_replaces_friction,
+    _terms_rest,
     _terms_zoned,
 )
 from sim.physics.layout import *
@@ -80,27 +80,6 @@ def _friction(v, zone, c):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True, error_model="numpy")
-def _string_modes(c, t0):  # type: ignore[no-untyped-def]
-    """Constants of the first string mode of each free span (0 drive side, 1 weight side)."""
-    for span in range(2):
-        if span == 0:  # the drive span hangs vertically, tilted by drive_span_tilt_deg
-            length = c[R_DRIVE_SPAN]
-            g_perp = c[R_GRAVITY] * math.sin(math.radians(c[R_TV_TILT]))
-        else:
-            length = c[R_FREE_SPAN]
-            g_perp = c[R_G_PERP_WEIGHT_SPAN]
-        w = (math.pi / length) ** 2 / c[R_LIN_DENSITY]  # ω² per newton of tension
-        force = 4.0 / math.pi * g_perp * c[R_TV_LOAD]  # modal load per modal mass, m/s²
-        rest = force / (w * t0)
-        c[D_W1 + span] = w
-        c[D_F1 + span] = force
-        c[D_AR1 + span] = rest
-        c[D_AR1SQ + span] = rest * rest
-        c[D_ST1 + span] = math.pi**2 / (4.0 * length)  # geometric stretch = ST·a²
-        c[D_CM1 + span] = 2.0 * c[R_TV_ZETA] * math.sqrt(w * t0)
-
-
-@njit(cache=True, error_model="numpy")
 def pack(row, knots, coef):  # type: ignore[no-untyped-def]
     """The constants array c of one run: row, derived constants, rest state, table."""
     n = knots.shape[0]
@@ -119,9 +98,9 @@ def pack(row, knots, coef):  # type: ignore[no-untyped-def]
     c[D_NSEG] = 1.0
     c[D_K1], c[D_C1], c[D_K2], c[D_C2] = k, damp, k, damp
     c[D_D10], c[D_D20] = c[P_PRELOAD], c[P_PRELOAD]
-    kb = c[R_VE_K] if c[R_VE_ON] > 0.0 else 0.0
-    c[D_KB1], c[D_KB2] = kb, kb
-    osc, real = 0.0, 0.0
+    # The terms' constants, and the oscillations (for RK4, and what the exponential
+    # step leaves) and decays they bring, 1/s: maxima, in any order.
+    osc, osc_exp, real = _terms_pack(c, 0.0, 0.0, 0.0)
     if c[R_PI_ON] > 0.0:  # two segments; the wrapped arc is shared half and half
         total, l1, l2 = c[R_FIBRE_LEN], c[R_DRIVE_SPAN], c[R_FREE_SPAN]
         half = 0.5 * (total - l1 - l2)
@@ -129,42 +108,21 @@ def pack(row, knots, coef):  # type: ignore[no-untyped-def]
         c[D_NSEG] = 2.0
         c[D_K1], c[D_C1], c[D_K2], c[D_C2] = k * f1, damp * f1, k * f2, damp * f2
         c[D_D10], c[D_D20] = t0 / (k * f1), t0 / (k * f2)
-        c[D_KB1], c[D_KB2] = kb * f1, kb * f2
+        c[D_KB1], c[D_KB2] = c[D_KB1] * f1, c[D_KB2] * f2  # a branch's k₂ by its length
         r = c[R_RADIUS]
         c[D_MP] = c[R_PI_J] / (r * r)
         c[D_FB0] = c[R_PI_TORQUE] / r
         c[D_FBL] = c[R_PI_LOAD] * c[R_SIN_HALF_WRAP]
         c[D_SIGP] = (c[D_FB0] + 2.0 * c[D_FBL] * t0) / c[R_PI_PRESLIDE]
         stiff = c[D_K1] + c[D_K2] + c[D_KB1] + c[D_KB2] + c[D_SIGP]
-        osc = math.sqrt(stiff / c[D_MP])
+        rim = math.sqrt(stiff / c[D_MP])
+        osc, osc_exp = max(osc, rim), max(osc_exp, rim)
         c[E_RIM] = (c[D_C1] + c[D_C2]) / c[D_MP]
-    if c[R_VE_ON] > 0.0:
-        c[D_RELAX] = 1.0 / c[R_VE_TAU]
-        real = max(real, c[D_RELAX])
-    if c[R_TV_ON] > 0.0:
-        _string_modes(c, t0)
-    if c[R_SS_ON] > 0.0 and c[P_FRICTION_N] > 0.0:  # LuGre needs a friction table
-        c[D_SS_ON] = 1.0
-        c[D_SIG0] = c[R_SS_SIGMA]
-        c[D_SIG1] = 2.0 * math.sqrt(c[R_SS_SIGMA] * c[P_MASS])
-        osc = max(osc, math.sqrt(c[R_SS_SIGMA] / c[P_MASS]))
-    c[E_OSC] = osc
-    if c[D_SS_ON] > 0.0:
-        # What an exact relaxation leaves to RK4: the damping σ₁·shape·ż couples the
-        # weight to it at σ₁·shape(v)·σ₀|v|/g(v) per metre of bristle, against σ₀; its
-        # worst is where |v|·shape(v) peaks, at |v/v_s| = δ^(−1/δ). Measured (σ₀ 1e6 N/m,
-        # v_s 3 cm/s): at |λ|·h = 0.5 for it the force is off by 0.06 N, at 0.25 by 0.006 N.
-        power = c[R_SS_EXP]
-        v_peak = c[R_SS_VS] * power ** (-1.0 / power)
-        shape = math.exp(-1.0 / power)
-        g_peak = c[P_FRICTION_N] * _mu(v_peak, c) * (1.0 + c[R_SS_RATIO] * shape)
-        coupled = c[D_SIG1] * shape * c[R_SS_SIGMA] * v_peak / g_peak - c[R_SS_SIGMA]
-        c[E_OSC] = max(osc, 2.0 * math.sqrt(max(coupled, 0.0) / c[P_MASS]))
-    _terms_pack(c)
+    c[E_OSC] = osc_exp
     c[D_OSC], c[D_REAL] = osc, real
-    on = c[R_VE_ON] + c[R_TV_ON] + c[R_PI_ON] + c[R_SS_ON] + c[R_X_ON] + _terms_on(c)
+    on = c[R_PI_ON] + c[R_X_ON] + _terms_on(c)
     c[D_DYN] = 1.0 if on > 0.0 else 0.0
-    table = c[P_FRICTION_N] != 0.0 and c[D_SS_ON] == 0.0
+    table = c[P_FRICTION_N] != 0.0 and not _terms_replaces_friction(c)
     c[D_ZONES] = 1.0 if table or _terms_zoned(c) else 0.0
     c[S_TAUT1], c[S_TAUT2] = 1.0, 1.0
     c[E_H] = -1.0  # no rim weights yet
@@ -174,24 +132,17 @@ def pack(row, knots, coef):  # type: ignore[no-untyped-def]
 @njit(cache=True, error_model="numpy")
 def rest_state(c):  # type: ignore[no-untyped-def]
     """Static rest: weight and pulley still, fibre taut at T₀, strings at their gravity sag."""
-    if ON_TV and c[R_TV_ON] > 0.0:
-        return _state(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, c[D_AR1], 0.0, c[D_AR2], 0.0, 0.0)
-    return ZERO
+    return _terms_rest(c)
 
 
 @njit(cache=True, error_model="numpy")
 def _segments(c, y, xa, xb, xd):  # type: ignore[no-untyped-def]
     """(δ₁, F₁, δ₂, F₂, δ̇₁, δ̇₂): each segment's elongation and tension law at x = xa + xb."""
     n = c[P_PROJ]
-    ext1, rate1, ext2, rate2 = 0.0, 0.0, 0.0, 0.0
-    if ON_TV and c[R_TV_ON] > 0.0:
-        a1, a2 = y[Y_A1], y[Y_A2]
-        ext1 = c[D_ST1] * (a1 * a1 - c[D_AR1SQ])
-        rate1 = 2.0 * c[D_ST1] * a1 * y[Y_AD1]
-        ext2 = c[D_ST2] * (a2 * a2 - c[D_AR2SQ])
-        rate2 = 2.0 * c[D_ST2] * a2 * y[Y_AD2]
-    ext1, rate1, ext2, rate2 = _terms_extension(c, y, ext1, rate1, ext2, rate2)
-    q1, q2 = (y[Y_Q1], y[Y_Q2]) if ON_VE else (0.0, 0.0)  # + 0.0: the union's sum
+    # What the terms add to each segment's length and rate, and to its tension law (+ 0.0
+    # without: the union's sums, bit for bit).
+    ext1, rate1, ext2, rate2 = _terms_extension(c, y, 0.0, 0.0, 0.0, 0.0)
+    q1, q2 = _terms_branch(c, y, 0.0, 0.0)
     if not ON_PI or c[D_NSEG] < 1.5:
         d = c[D_D10] + xa + xb - n * y[Y_U] + (ext1 + ext2)
         dd = xd - n * y[Y_V] + (rate1 + rate2)
@@ -232,28 +183,15 @@ def _added_force(c, y, t2):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True, error_model="numpy")
-def _stribeck(v, c):  # type: ignore[no-untyped-def]
-    """The Stribeck curve's shape exp(−|v/v_s|^δ): 1 at rest, 0 when sliding fast."""
-    r = abs(v) / c[R_SS_VS]
-    if c[R_SS_EXP] == 2.0:  # the Gaussian (the default): no power function per step
-        return math.exp(-r * r)
-    return math.exp(-(r ** c[R_SS_EXP]))
-
-
-@njit(cache=True, error_model="numpy")
 def _rhs(c, y, xa, xd):  # type: ignore[no-untyped-def]
     """dy/dt at drive position xa (rate xd) in the current regimes."""
     sg = _segments(c, y, xa, 0.0, xd)
     t1, t2 = _tensions(c, sg)
     v = y[Y_V]
     zone = int(c[S_ZONE])
-    zd = 0.0
-    if ON_SS and c[D_SS_ON] > 0.0:  # LuGre replaces the table's friction
-        shape = _stribeck(v, c)
-        g = c[P_FRICTION_N] * _mu(abs(v), c) * (1.0 + c[R_SS_RATIO] * shape)
-        zd = v - c[D_SIG0] * abs(v) * y[Y_Z] / g
-        fric = c[D_SIG0] * y[Y_Z] + c[D_SIG1] * shape * zd
-    else:
+    # A term may replace the table's friction law (and bring its own state's rate).
+    replaced, fric, zd = _terms_friction_law(c, y, v, False, 0.0, 0.0)
+    if not replaced:
         fric = _friction(v, zone, c)
     fric = _terms_friction(c, v, zone, t2, fric)
     drive = -c[P_GRAVITY_N] - fric
@@ -261,23 +199,15 @@ def _rhs(c, y, xa, xd):  # type: ignore[no-untyped-def]
     if ON_X and c[R_X_ON] > 0.0:
         drive += _added_force(c, y, t2)
     acc = drive / c[P_MASS]
-    s_acc, dq1, dq2, aa1, aa2 = 0.0, 0.0, 0.0, 0.0, 0.0
+    s_acc = 0.0
     if ON_PI and c[D_NSEG] > 1.5:
         fp = 0.0
         if c[D_SIGP] > 0.0:
             zmax = _bearing_limit(c, t1, t2)
             fp = c[D_SIGP] * min(max(c[S_PZ] + y[Y_S] - c[S_PS0], -zmax), zmax)
         s_acc = (t1 - t2 - fp) / c[D_MP]
-    if ON_VE and c[R_VE_ON] > 0.0:
-        dq1 = (c[D_KB1] * sg[4] if c[S_TAUT1] > 0.0 else 0.0) - c[D_RELAX] * y[Y_Q1]
-        if c[D_NSEG] > 1.5:
-            dq2 = (c[D_KB2] * sg[5] if c[S_TAUT2] > 0.0 else 0.0) - c[D_RELAX] * y[Y_Q2]
-    if ON_TV and c[R_TV_ON] > 0.0:
-        aa1 = c[D_F1] - c[D_W1] * max(t1, 0.0) * y[Y_A1] - c[D_CM1] * y[Y_AD1]
-        aa2 = c[D_F2] - c[D_W2] * max(t2, 0.0) * y[Y_A2] - c[D_CM2] * y[Y_AD2]
     sd = y[Y_SD] if ON_PI else 0.0
-    ad1, ad2 = (y[Y_AD1], y[Y_AD2]) if ON_TV else (0.0, 0.0)
-    return _state(v, acc, sd, s_acc, dq1, dq2, ad1, aa1, ad2, aa2, zd)
+    return _terms_rates(c, y, sg, t1, t2, zd, v, acc, sd, s_acc)  # with the terms' rates
 
 
 @njit(cache=True, error_model="numpy")

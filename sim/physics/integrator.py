@@ -13,17 +13,8 @@ import math
 
 from numba import njit
 
-from sim.physics.fibre import (
-    _after_part,
-    _mu,
-    _rhs,
-    _segments,
-    _set_taut,
-    _stribeck,
-    _zone,
-)
+from sim.physics.fibre import _after_part, _rhs, _segments, _set_taut, _zone
 from sim.physics.kernel import (
-    BRISTLE_SWING,
     EXP_COST,
     MAX_SWITCH,
     NSUB_MAX,
@@ -34,6 +25,7 @@ from sim.physics.kernel import (
     _combine,
     _hermite,
     _stiff_set,
+    _terms_decay,
     _terms_substeps,
 )
 from sim.physics.layout import *
@@ -67,11 +59,7 @@ def _decay_rates(c, y, v):  # type: ignore[no-untyped-def]
     if c[D_NSEG] > 1.5:
         damp = (c[D_C1] if c[S_TAUT1] > 0.0 else 0.0) + (c[D_C2] if c[S_TAUT2] > 0.0 else 0.0)
         rim = damp / c[D_MP]
-    bristle = 0.0
-    if c[D_SS_ON] > 0.0:
-        g = c[P_FRICTION_N] * _mu(abs(v), c) * (1.0 + c[R_SS_RATIO] * _stribeck(v, c))
-        bristle = c[D_SIG0] * abs(v) / g
-    return rim, bristle
+    return rim, _terms_decay(c, v, 0.0)
 
 
 _INVERSE = tuple(1.0 / k if k else 0.0 for k in range(18))  # 1/k: the series multiplies
@@ -261,31 +249,10 @@ def _substeps(c, y, x, xd, dt, base):  # type: ignore[no-untyped-def]
     sg = _segments(c, y, x, 0.0, xd)
     t_est = 1.5 * max(sg[1], sg[3], 0.0) + c[D_T0]
     osc, osc_exp, real = c[D_OSC], c[E_OSC], c[D_REAL]
-    strings = abs(y[Y_A1]) + abs(y[Y_AD1]) + abs(y[Y_A2]) + abs(y[Y_AD2]) + abs(c[D_F1] + c[D_F2])
-    if c[R_TV_ON] > 0.0 and strings > 0.0:  # an unexcited string mode stays exactly zero
-        modes = math.sqrt(max(c[D_W1], c[D_W2]) * t_est) + c[D_CM1] + c[D_CM2]
-        osc, osc_exp = max(osc, modes), max(osc_exp, modes)
-    real = _terms_substeps(c, t_est, real)
     real_exp = real
-    real = max(real, c[E_RIM])
-    if c[D_SS_ON] > 0.0:
-        speed = abs(y[Y_V]) + 0.05
-        g_min = c[P_FRICTION_N] * _mu(speed, c)
-        relax = c[D_SIG0] * speed / g_min
-        real = max(real, relax + c[D_SIG1] / c[P_MASS])
-        # Exact for a frozen rate, but the rate swings through the Stribeck dip at every
-        # reversal: still a bound, four times looser (σ₀ 1e6 N/m: 0.04 N off without).
-        # Away from reversals the frozen rate errs by the rate's relative change within a
-        # step, |a|/|v|·(1 + r·δ/e) at most (|v|/g(v) through the Stribeck dip), |a| at
-        # most what the tensions, gravity and friction can give: a tenth per step.
-        pull = c[P_PROJ] * t_est + c[P_GRAVITY_N] + g_min * (1.0 + c[R_SS_RATIO])
-        a_max = pull / c[P_MASS]
-        slowest = abs(y[Y_V]) - a_max * dt
-        swing = relax / 4.0
-        if slowest > 0.0:
-            dip = 1.0 + c[R_SS_RATIO] * c[R_SS_EXP] / math.e
-            swing = min(swing, 1.5 * a_max / slowest * dip / BRISTLE_SWING)
-        real_exp = max(real_exp, c[D_SIG1] / c[P_MASS], swing)
+    real = max(real, c[E_RIM])  # the rim's damping: exact in the exponential step
+    # The terms' rates in this interval (maxima, in any order; see each term's hook).
+    osc, osc_exp, real, real_exp = _terms_substeps(c, y, dt, t_est, osc, osc_exp, real, real_exp)
     n = max(base, math.ceil(dt * osc / 0.5), math.ceil(dt * real / 1.5))
     n_exp = max(base, math.ceil(dt * osc_exp / 0.5), math.ceil(dt * real_exp / 1.5))
     if EXP_COST * n_exp < n:

@@ -167,19 +167,50 @@ from sim.effects.fibre_pulley_jump.terms import (
     pj_given_start,
     pj_start,
 )
+from sim.effects.fibre_transverse_vibration.terms import (
+    tv_extension,
+    tv_pack,
+    tv_rates,
+    tv_rest,
+    tv_start_state,
+    tv_substeps,
+)
+from sim.effects.fibre_viscoelastic.terms import ve_branch, ve_pack, ve_rates, ve_start_state
 from sim.effects.side_load_friction.terms import sl_friction, sl_pack, sl_substeps, sl_zoned
+from sim.effects.stick_slip_friction.terms import (
+    ss_decay,
+    ss_friction_law,
+    ss_pack,
+    ss_rates,
+    ss_replaces_friction,
+    ss_start_state,
+    ss_substeps,
+)
 
 
 @njit(cache=True, error_model="numpy")
 def _terms_on(c):  # type: ignore[no-untyped-def]
     """How many of the composed terms are on (> 0: any)."""
-    return 0.0 + c[R_PJ_ON] + c[R_SL_ON]
+    return 0.0 + c[R_VE_ON] + c[R_TV_ON] + c[R_PJ_ON] + c[R_SS_ON] + c[R_SL_ON]
 
 
 @njit(cache=True, error_model="numpy")
-def _terms_pack(c):  # type: ignore[no-untyped-def]
+def _terms_pack(c, osc, osc_exp, real):  # type: ignore[no-untyped-def]
     """The composed terms' ``pack`` hooks."""
-    sl_pack(c)
+    osc, osc_exp, real = ve_pack(c, osc, osc_exp, real)
+    osc, osc_exp, real = tv_pack(c, osc, osc_exp, real)
+    osc, osc_exp, real = ss_pack(c, osc, osc_exp, real)
+    osc, osc_exp, real = sl_pack(c, osc, osc_exp, real)
+    return osc, osc_exp, real
+
+
+@njit(cache=True, error_model="numpy")
+def _terms_replaces_friction(c):  # type: ignore[no-untyped-def]
+    """The composed terms' ``replaces_friction`` hooks."""
+    said = False
+    this = ss_replaces_friction(c)
+    said = said or this
+    return said
 
 
 @njit(cache=True, error_model="numpy")
@@ -194,8 +225,23 @@ def _terms_zoned(c):  # type: ignore[no-untyped-def]
 @njit(cache=True, error_model="numpy")
 def _terms_extension(c, y, ext1, rate1, ext2, rate2):  # type: ignore[no-untyped-def]
     """The composed terms' ``extension`` hooks."""
+    ext1, rate1, ext2, rate2 = tv_extension(c, y, ext1, rate1, ext2, rate2)
     ext1, rate1, ext2, rate2 = pj_extension(c, y, ext1, rate1, ext2, rate2)
     return ext1, rate1, ext2, rate2
+
+
+@njit(cache=True, error_model="numpy")
+def _terms_branch(c, y, q1, q2):  # type: ignore[no-untyped-def]
+    """The composed terms' ``branch`` hooks."""
+    q1, q2 = ve_branch(c, y, q1, q2)
+    return q1, q2
+
+
+@njit(cache=True, error_model="numpy")
+def _terms_friction_law(c, y, v, replaced, fric, zd):  # type: ignore[no-untyped-def]
+    """The composed terms' ``friction_law`` hooks."""
+    replaced, fric, zd = ss_friction_law(c, y, v, replaced, fric, zd)
+    return replaced, fric, zd
 
 
 @njit(cache=True, error_model="numpy")
@@ -206,10 +252,19 @@ def _terms_friction(c, v, zone, t2, fric):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True, error_model="numpy")
-def _terms_substeps(c, t_est, real):  # type: ignore[no-untyped-def]
+def _terms_decay(c, v, rate):  # type: ignore[no-untyped-def]
+    """The composed terms' ``decay`` hooks."""
+    rate = ss_decay(c, v, rate)
+    return rate
+
+
+@njit(cache=True, error_model="numpy")
+def _terms_substeps(c, y, dt, t_est, osc, osc_exp, real, real_exp):  # type: ignore[no-untyped-def]
     """The composed terms' ``substeps`` hooks."""
-    real = sl_substeps(c, t_est, real)
-    return real
+    osc, osc_exp, real, real_exp = tv_substeps(c, y, dt, t_est, osc, osc_exp, real, real_exp)
+    osc, osc_exp, real, real_exp = ss_substeps(c, y, dt, t_est, osc, osc_exp, real, real_exp)
+    osc, osc_exp, real, real_exp = sl_substeps(c, y, dt, t_est, osc, osc_exp, real, real_exp)
+    return osc, osc_exp, real, real_exp
 
 
 @njit(cache=True, error_model="numpy")
@@ -243,6 +298,52 @@ def _terms_given_end(c):  # type: ignore[no-untyped-def]
 def _terms_start(c, m):  # type: ignore[no-untyped-def]
     """The composed terms' ``start`` hooks."""
     pj_start(c, m)
+
+
+@njit(cache=True, error_model="numpy")
+def _terms_rest(c):  # type: ignore[no-untyped-def]
+    """The whole state: the composed terms' ``rest`` hooks give their own."""
+    (
+        r_a1,
+        r_ad1,
+        r_a2,
+        r_ad2,
+    ) = tv_rest(c)
+    return _state(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, r_a1, r_ad1, r_a2, r_ad2, 0.0)
+
+
+@njit(cache=True, error_model="numpy")
+def _terms_rates(c, y, sg, t1, t2, zd, v, acc, sd, s_acc):  # type: ignore[no-untyped-def]
+    """The whole state: the composed terms' ``rates`` hooks give their own."""
+    (
+        r_q1,
+        r_q2,
+    ) = ve_rates(c, y, sg, t1, t2, zd)
+    (
+        r_a1,
+        r_ad1,
+        r_a2,
+        r_ad2,
+    ) = tv_rates(c, y, sg, t1, t2, zd)
+    (r_z,) = ss_rates(c, y, sg, t1, t2, zd)
+    return _state(v, acc, sd, s_acc, r_q1, r_q2, r_a1, r_ad1, r_a2, r_ad2, r_z)
+
+
+@njit(cache=True, error_model="numpy")
+def _terms_start_state(c, x, xd, u, v, force, taut, m, s, sd):  # type: ignore[no-untyped-def]
+    """The whole state: the composed terms' ``start_state`` hooks give their own."""
+    (
+        r_q1,
+        r_q2,
+    ) = ve_start_state(c, x, xd, u, v, force, taut, m)
+    (
+        r_a1,
+        r_ad1,
+        r_a2,
+        r_ad2,
+    ) = tv_start_state(c, x, xd, u, v, force, taut, m)
+    (r_z,) = ss_start_state(c, x, xd, u, v, force, taut, m)
+    return _state(u, v, s, sd, r_q1, r_q2, r_a1, r_ad1, r_a2, r_ad2, r_z)
 
 
 # </hooks>

@@ -29,17 +29,44 @@ PARTS = ("fibre.py", "integrator.py", "runners.py")
 #: passes on to the next and the last returns; None: a yes/no, yes if any term says so;
 #: (): called for its effect on c.
 HOOKS: dict[str, tuple[tuple[str, ...], tuple[str, ...] | None]] = {
-    "pack": (("c",), ()),  # derived constants into c
+    # derived constants into c; the oscillations (RK4's, the exponential step's) and
+    # decays the term brings, 1/s (maxima)
+    "pack": (("c", "osc", "osc_exp", "real"), ("osc", "osc_exp", "real")),
+    "replaces_friction": (("c",), None),  # its law replaces the table's friction
     "zoned": (("c",), None),  # friction has the baseline's branches
     "extension": (("c", "y", "ext1", "rate1", "ext2", "rate2"), ("ext1", "rate1", "ext2", "rate2")),
-    "friction": (("c", "v", "zone", "t2", "fric"), ("fric",)),  # guide friction, N
-    "substeps": (("c", "t_est", "real"), ("real",)),  # fastest decay, 1/s
+    "branch": (("c", "y", "q1", "q2"), ("q1", "q2")),  # force in each segment's tension law
+    "friction_law": (("c", "y", "v", "replaced", "fric", "zd"), ("replaced", "fric", "zd")),
+    "friction": (("c", "v", "zone", "t2", "fric"), ("fric",)),  # added guide friction, N
+    "decay": (("c", "v", "rate"), ("rate",)),  # its state's decay for the exponential step
+    # this interval's oscillations and decays, 1/s (maxima)
+    "substeps": (
+        ("c", "y", "dt", "t_est", "osc", "osc_exp", "real", "real_exp"),
+        ("osc", "osc_exp", "real", "real_exp"),
+    ),
     "after_part": (("c", "y", "x", "xd", "h"), ()),  # discrete state after a part
     "given_start": (("c", "given"), None),  # follows a recorded input this run
     "given_at": (("c", "value"), ()),  # the input over the next interval
     "given_end": (("c",), ()),
     "start": (("c", "m"), ()),  # discrete state at a measured start
 }  # fmt: skip
+#: The hooks that give a term's own states (``layout.STATES``, in their order): its
+#: values at rest, their rates, their values at a measured start. The composed set's
+#: ``_terms_<hook>`` builds the whole state: the extra arguments give the baseline's
+#: (and the pulley rim's) entries, a term not composed in gives zeros.
+STATE_HOOKS: dict[str, tuple[tuple[str, ...], tuple[str, ...], dict[str, str]]] = {
+    "rest": (("c",), (), {"U": "0.0", "V": "0.0", "S": "0.0", "SD": "0.0"}),
+    "rates": (
+        ("c", "y", "sg", "t1", "t2", "zd"),
+        ("v", "acc", "sd", "s_acc"),
+        {"U": "v", "V": "acc", "S": "sd", "SD": "s_acc"},
+    ),
+    "start_state": (
+        ("c", "x", "xd", "u", "v", "force", "taut", "m"),
+        ("s", "sd"),
+        {"U": "u", "V": "v", "S": "s", "SD": "sd"},
+    ),
+}
 
 
 def term_files(terms: tuple[str, ...]) -> list[tuple[str, Path]]:
@@ -95,6 +122,21 @@ def hooks_block(terms: tuple[str, ...]) -> str:
             body += [f"    {func}({call_args})" for func in calls] or ["    return"]
         lines += ["", "", _NJIT, f"def _terms_{hook}({call_args}):  # type: ignore[no-untyped-def]",
                   f'    """The composed terms\' ``{hook}`` hooks."""', *body]  # fmt: skip
+    for hook, (args, extra, given) in STATE_HOOKS.items():
+        body = []
+        value = dict(given)
+        for symbol, functions in defined.items():
+            func = f"{symbol.lower()}_{hook}"
+            own = [name.lower() for name, owner in layout.STATES if owner == symbol]
+            if func in functions and own:
+                targets = ", ".join(f"r_{n}" for n in own)
+                body.append(f"    ({targets},) = {func}({', '.join(args)})")
+                value.update({n.upper(): f"r_{n}" for n in own})
+        every = ", ".join(value.get(name, "0.0") for name, _ in layout.STATES)
+        doc = f"The whole state: the composed terms' ``{hook}`` hooks give their own."
+        signature = ", ".join(args + extra)
+        lines += ["", "", _NJIT, f"def _terms_{hook}({signature}):  # type: ignore[no-untyped-def]",
+                  f'    """{doc}"""', *body, f"    return _state({every})"]  # fmt: skip
     return "\n".join(lines) + "\n\n\n"
 
 

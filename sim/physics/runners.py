@@ -13,11 +13,9 @@ from numba import njit, prange
 
 from sim.physics.fibre import (
     _bearing_limit,
-    _mu,
     _sample_out,
     _segments,
     _set_taut,
-    _stribeck,
     _tensions,
     _zone,
     pack,
@@ -27,14 +25,12 @@ from sim.physics.integrator import _step, _substeps
 from sim.physics.kernel import (
     NCARRY,
     ON_PI,
-    ON_SS,
-    ON_TV,
     _carry_out,
-    _state,
     _terms_given_at,
     _terms_given_end,
     _terms_given_start,
     _terms_start,
+    _terms_start_state,
     _tuple_of,
     _with_carried,
 )
@@ -123,16 +119,10 @@ def measured_state(c, x, xd, m):  # type: ignore[no-untyped-def]
     states are not measured and take quasi-static values: pulley rim where the drive-side
     segment carries the measured F (taut) or both segments equal tension (slack), moving
     with the fibre, bearing presliding holding the tension difference (within its limit);
-    Maxwell branches at k₂·hp, hp the elongation high-passed with τ (the branch's response
-    to the measured history, computed by the caller); string modes at their static sag
-    for the measured tension (rest sag while slack; ``simulate_chained_into`` replaces
-    them by the previous segment's); LuGre bristle holding the measured
-    force balance n·F − m·g·sin α, limited to (and, faster than v_s, at) its sliding
-    value; pulley-jump seat from the recorded slack episodes (``measured_seats``, in
-    m's I_LOFF … I_SLACKT; a seat estimated from the measured elongation at the start,
-    rounded to one of the two grooves, picked the wrong groove often enough to cost 340×
-    the open-loop error on a clean recording).
-    Sets the discrete state in c; returns the continuous state tuple.
+    each term's from its ``start_state`` hook (its continuous states, from the measured
+    values and the columns the caller filled, e.g. I_HP) and its ``start`` hook (its
+    discrete state in c); ``simulate_chained_into`` replaces the carried ones by the
+    previous segment's. Sets the discrete state in c; returns the continuous state tuple.
     """
     u, v, force = m[I_U], m[I_V], m[I_F]
     n = c[P_PROJ]
@@ -145,20 +135,7 @@ def measured_state(c, x, xd, m):  # type: ignore[no-untyped-def]
             s = c[D_D10] + x - (force - c[D_C1] * (xd - sd)) / k1
         else:
             s = (k1 * (c[D_D10] + x) - k2 * (c[D_D20] - n * u)) / (k1 + k2)
-    a1, a2 = 0.0, 0.0
-    if ON_TV and c[R_TV_ON] > 0.0:
-        scale = c[D_T0] / force if taut else 1.0
-        a1, a2 = c[D_AR1] * scale, c[D_AR2] * scale
-    z = 0.0
-    if ON_SS and c[D_SS_ON] > 0.0:
-        g = c[P_FRICTION_N] * _mu(abs(v), c) * (1.0 + c[R_SS_RATIO] * _stribeck(v, c))
-        limit = g / c[D_SIG0]
-        if abs(v) > c[R_SS_VS]:
-            z = limit if v > 0.0 else -limit
-        else:
-            z = min(max((n * max(force, 0.0) - c[P_GRAVITY_N]) / c[D_SIG0], -limit), limit)
-    q1, q2 = c[D_KB1] * m[I_HP], c[D_KB2] * m[I_HP]
-    y = _state(u, v, s, sd, q1, q2, a1, 0.0, a2, 0.0, z)
+    y = _terms_start_state(c, x, xd, u, v, force, taut, m, s, sd)  # the terms' own
     _terms_start(c, m)
     c[S_PZ], c[S_PS0] = 0.0, s
     if ON_PI and c[D_NSEG] > 1.5 and c[D_SIGP] > 0.0:

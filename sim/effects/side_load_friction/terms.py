@@ -18,10 +18,11 @@ from sim.physics.layout import *
 
 
 @njit(cache=True, error_model="numpy")
-def sl_pack(c):  # type: ignore[no-untyped-def]
+def sl_pack(c, osc, osc_exp, real):  # type: ignore[no-untyped-def]
     """Its derived constant in c."""
     if c[R_SL_ON] > 0.0:
         c[D_SL] = c[R_SL_MU] * c[R_SIN_BETA]
+    return osc, osc_exp, real
 
 
 @njit(cache=True, error_model="numpy")
@@ -40,8 +41,9 @@ def sl_friction(c, v, zone, t2, fric):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True, error_model="numpy")
-def sl_substeps(c, t_est, real):  # type: ignore[no-untyped-def]
+def sl_substeps(c, y, dt, t_est, osc, osc_exp, real, real_exp):  # type: ignore[no-untyped-def]
     """Its decay inside the regularisation band, 1/s: μ·sin β·T/(v_reg·m)."""
     if c[R_SL_ON] > 0.0:
-        real = max(real, c[D_SL] * t_est / (c[P_VREG] * c[P_MASS]))
-    return real
+        band = c[D_SL] * t_est / (c[P_VREG] * c[P_MASS])
+        real, real_exp = max(real, band), max(real_exp, band)
+    return osc, osc_exp, real, real_exp
