@@ -103,6 +103,7 @@ def source_for(terms: tuple[str, ...], added: tuple[EffectInfo, ...] = ()) -> st
     text = kernel_source.splice(text, "layout", "\n".join(head))
     text = kernel_source.splice(text, "state", kernel_source.state_block(terms))
     text = kernel_source.splice(text, "hooks", kernel_source.hooks_block(terms))
+    text = kernel_source.splice_sites(text, terms)
     return kernel_source.splice(text, "added-force", _added_block(added))
 
 

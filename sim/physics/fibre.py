@@ -141,8 +141,13 @@ def _segments(c, y, xa, xb, xd):  # type: ignore[no-untyped-def]
     n = c[P_PROJ]
     # What the terms add to each segment's length and rate, and to its tension law (+ 0.0
     # without: the union's sums, bit for bit).
-    ext1, rate1, ext2, rate2 = _terms_extension(c, y, 0.0, 0.0, 0.0, 0.0)
-    q1, q2 = _terms_branch(c, y, 0.0, 0.0)
+    ext1, rate1, ext2, rate2, q1, q2 = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    # <splice extension>
+    ext1, rate1, ext2, rate2 = _terms_extension(c, y, ext1, rate1, ext2, rate2)
+    # </splice extension>
+    # <splice branch>
+    q1, q2 = _terms_branch(c, y, q1, q2)
+    # </splice branch>
     if not ON_PI or c[D_NSEG] < 1.5:
         d = c[D_D10] + xa + xb - n * y[Y_U] + (ext1 + ext2)
         dd = xd - n * y[Y_V] + (rate1 + rate2)
@@ -190,10 +195,15 @@ def _rhs(c, y, xa, xd):  # type: ignore[no-untyped-def]
     v = y[Y_V]
     zone = int(c[S_ZONE])
     # A term may replace the table's friction law (and bring its own state's rate).
-    replaced, fric, zd = _terms_friction_law(c, y, v, False, 0.0, 0.0)
+    replaced, fric, zd = False, 0.0, 0.0
+    # <splice friction_law>
+    replaced, fric, zd = _terms_friction_law(c, y, v, replaced, fric, zd)
+    # </splice friction_law>
     if not replaced:
         fric = _friction(v, zone, c)
+    # <splice friction>
     fric = _terms_friction(c, v, zone, t2, fric)
+    # </splice friction>
     drive = -c[P_GRAVITY_N] - fric
     drive += c[P_PROJ] * t2  # + 0.0 while slack: the baseline's sum, bit for bit
     if ON_X and c[R_X_ON] > 0.0:
@@ -207,7 +217,9 @@ def _rhs(c, y, xa, xd):  # type: ignore[no-untyped-def]
             fp = c[D_SIGP] * min(max(c[S_PZ] + y[Y_S] - c[S_PS0], -zmax), zmax)
         s_acc = (t1 - t2 - fp) / c[D_MP]
     sd = y[Y_SD] if ON_PI else 0.0
+    # <splice rates>
     return _terms_rates(c, y, sg, t1, t2, zd, v, acc, sd, s_acc)  # with the terms' rates
+    # </splice rates>
 
 
 @njit(cache=True, error_model="numpy")
@@ -226,7 +238,9 @@ def _after_part(c, y, x, xd, h):  # type: ignore[no-untyped-def]
         zmax = _bearing_limit(c, t1, t2)
         c[S_PZ] = min(max(c[S_PZ] + y[Y_S] - c[S_PS0], -zmax), zmax)
         c[S_PS0] = y[Y_S]
+    # <splice after_part>
     _terms_after_part(c, y, x, xd, h)
+    # </splice after_part>
 
 
 @njit(cache=True, error_model="numpy")

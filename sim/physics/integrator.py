@@ -252,7 +252,9 @@ def _substeps(c, y, x, xd, dt, base):  # type: ignore[no-untyped-def]
     real_exp = real
     real = max(real, c[E_RIM])  # the rim's damping: exact in the exponential step
     # The terms' rates in this interval (maxima, in any order; see each term's hook).
+    # <splice substeps>
     osc, osc_exp, real, real_exp = _terms_substeps(c, y, dt, t_est, osc, osc_exp, real, real_exp)
+    # </splice substeps>
     n = max(base, math.ceil(dt * osc / 0.5), math.ceil(dt * real / 1.5))
     n_exp = max(base, math.ceil(dt * osc_exp / 0.5), math.ceil(dt * real_exp / 1.5))
     if EXP_COST * n_exp < n:

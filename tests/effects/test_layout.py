@@ -5,8 +5,10 @@ from __future__ import annotations
 import ast
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
+import pytest
 
 from sim.config import StandConfig
 from sim.effects import EFFECTS
@@ -51,6 +53,15 @@ def test_the_row_follows_the_registry_order_effect_by_effect() -> None:
     assert max(after) < layout.C_TABLE
 
 
+def test_the_unions_state_names_follow_the_state_table() -> None:
+    names = [name for name, _ in layout.STATES]
+    assert [getattr(layout, f"Y_{name}") for name in names] == list(range(len(names)))
+    assert len(names) == layout.NY
+    assert set(layout.CARRIED) <= set(names)
+    assert layout.constants(layout.TERMS, False)["NY"] == len(names)
+    assert layout.constants((), False)["Y_Z"] == -1  # the baseline has no bristle
+
+
 def test_the_heads_own_blocks_are_what_compose_writes_for_the_union() -> None:
     # The head shows the union's tuple helpers and hook calls (and imports the hooks, for
     # linting); a composed model runs the written ones.
@@ -84,3 +95,34 @@ def test_the_baseline_has_two_states_and_the_union_every_terms(stand: StandConfi
     # Different sets, different files: a set's machine code is never another's.
     assert base.__name__ != union.__name__
     assert np.array_equal(base.pack(*c_args), union.pack(*c_args))
+
+
+def test_the_hot_hooks_are_written_in_place_not_called() -> None:
+    union = compose.source_for(layout.TERMS)
+    for hook in kernel_source.SPLICED:
+        site = union[union.index(f"# <splice {hook}>") : union.index(f"# </splice {hook}>")]
+        assert f"_terms_{hook}(" not in site, hook
+    segments = union[union.index("def _segments(") : union.index("def _tensions(")]
+    assert "ext2 += c[S_LOFF]" in segments  # the pulley jump's extension, in place
+    baseline = compose.source_for(())
+    rhs = baseline[baseline.index("def _rhs(") : baseline.index("def _set_taut(")]
+    assert "return _state(v, acc, sd, s_acc, 0.0" in rhs  # no term's rates
+
+
+def test_a_spliced_hook_takes_the_sites_names_and_returns_once_at_its_end(
+    tmp_path: Path,
+) -> None:
+    args = ("c", "v", "zone", "t2", "fric")
+    path = tmp_path / "terms.py"
+    path.write_text("def xx_friction(c, v, zone, t2, fric):\n    fric += 1.0\n    return fric\n")
+    assert kernel_source._hook_body(path, "xx_friction", args, "fric") == [
+        "fric += 1.0",
+        "fric = fric",
+    ]
+    early = "    if v > 0:\n        return 0.0\n"
+    path.write_text(f"def xx_friction(c, v, zone, t2, fric):\n{early}    return fric\n")
+    with pytest.raises(ValueError, match="return once"):
+        kernel_source._hook_body(path, "xx_friction", args, "fric")
+    path.write_text("def xx_friction(c, speed, zone, t2, fric):\n    return fric\n")
+    with pytest.raises(ValueError, match="must take"):
+        kernel_source._hook_body(path, "xx_friction", args, "fric")

@@ -68,7 +68,8 @@ def ss_friction_law(c, y, v, replaced, fric, zd):  # type: ignore[no-untyped-def
         shape = _stribeck(v, c)
         g = c[P_FRICTION_N] * _mu(abs(v), c) * (1.0 + c[R_SS_RATIO] * shape)
         zd = v - c[D_SIG0] * abs(v) * y[Y_Z] / g
-        return True, c[D_SIG0] * y[Y_Z] + c[D_SIG1] * shape * zd, zd
+        fric = c[D_SIG0] * y[Y_Z] + c[D_SIG1] * shape * zd
+        replaced = True
     return replaced, fric, zd
 
 
