@@ -1,9 +1,10 @@
-"""The fibre, the weight and the built-in terms: constants, forces and right-hand side.
+"""The fibre, the weight and the pulley's second segment: constants, forces, right-hand side.
 
 A part of the compiled model's text, never run as itself: ``sim.physics.compose`` writes
-``kernel.py`` (the head: layout and state helpers) and the parts ``fibre``,
-``integrator`` and ``runners`` into one module for a set of terms. Its imports are for
-reading and linting only.
+``kernel.py`` (the head: layout, state helpers, hook calls), the parts ``fibre``,
+``integrator`` and ``runners`` and the composed terms into one module for a set of terms;
+the ``# <splice HOOK>`` sites get the terms' bodies. Its imports are for reading and
+linting only.
 """
 
 from __future__ import annotations

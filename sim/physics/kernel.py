@@ -1,11 +1,14 @@
 """The compiled model's head: its layout, state helpers and constants (source text only).
 
-The model is one text in four parts — this head, ``fibre`` (the fibre, the weight and the
-built-in terms: constants, forces, right-hand side), ``integrator`` (RK4 / ETDRK4 steps
-split at located events, substeps) and ``runners`` (from rest, batch, segments, chained,
-block by block) — never imported as itself: ``sim.physics.compose`` writes it, composed
-for a set of terms, into one hash-named module (the head's two marked blocks: the
-layout's constants, the state's tuple helpers; ``fibre``'s: the added effects' forces).
+The model is one text in four parts — this head, ``fibre`` (the fibre, the weight, the
+pulley's second segment: constants, forces, right-hand side), ``integrator`` (RK4 /
+ETDRK4 steps split at located events, substeps) and ``runners`` (from rest, batch,
+segments, chained, block by block) — then each composed term's ``terms.py``. It is never
+imported as itself: ``sim.physics.compose`` writes it, composed for a set of terms, into
+one hash-named module (the head's marked blocks: the layout's constants, the state's
+tuple helpers, the terms' hook calls; ``fibre``'s: the added effects' forces; the splice
+sites of ``fibre`` and ``integrator``: the bodies of the composed terms' hooks on the
+right-hand side's path, ``kernel_source.SPLICED``).
 The empty set is the baseline of STAND.md §2; the union has every built-in term, and an
 effect switched off in a row adds exact zeros, so both give the baseline's numbers bit
 for bit with every effect off.
@@ -39,12 +42,14 @@ exponential step (``_etdrk4``) where it pays.
 
 Speed: the hot functions take c and scalars or tuples only; passing arrays to small
 jitted functions costs 7 machine words per array per call (measured: 60 → 9 ms for 10 s
-at 2 kHz). A term that is out of the set is pruned at compile time (``ON_*``), so the
-baseline runs on two states without the terms' branches. All numba code of the model is
-in this one text on purpose: numba's cache does not notice changes in jitted functions
-or constants imported from other modules; a composed module's name is a hash of its
-whole text instead. Each effect's parameters, ranges and hooks are in its own module
-(``sim/effects/*.py``); the parts' import blocks are for reading and linting only.
+at 2 kHz). A term that is out of the set is not written in, and the pulley's branches
+are pruned at compile time (``ON_PI``), so the baseline runs on two states without the
+terms' branches. The hooks on the right-hand side's path are written in place, not
+called (``kernel_source.SPLICED``: called, they made the union 3–4.5× slower). All numba
+code of the model is composed into one text on purpose: numba's cache does not notice
+changes in jitted functions or constants imported from other modules; a composed
+module's name is a hash of its whole text instead. The parts' and the terms' import
+blocks are for reading and linting only.
 """
 
 from __future__ import annotations
