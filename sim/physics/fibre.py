@@ -1,4 +1,4 @@
-"""The fibre, the weight and the pulley's second segment: constants, forces, right-hand side.
+"""The fibre (one segment or two), the weight, the friction: constants, forces, rates.
 
 A part of the compiled model's text, never run as itself: ``sim.physics.compose`` writes
 ``kernel.py`` (the head: layout, state helpers, hook calls), the parts ``fibre``,
@@ -10,14 +10,12 @@ linting only.
 from __future__ import annotations
 
 # <imports>
-import math
-
 import numpy as np
 from numba import njit
 
 from sim.physics.kernel import (
-    ON_PI,
     ON_X,
+    SEGMENTS,
     _terms_after_part,
     _terms_branch,
     _terms_extension,
@@ -28,6 +26,8 @@ from sim.physics.kernel import (
     _terms_rates,
     _terms_replaces_friction,
     _terms_rest,
+    _terms_segments,
+    _terms_settle,
     _terms_zoned,
 )
 from sim.physics.layout import *
@@ -94,7 +94,7 @@ def pack(row, knots, coef):  # type: ignore[no-untyped-def]
         for i in range(n - 1):
             c[C_TABLE + 1 + n + r * (n - 1) + i] = coef[r, i]
     k, damp = c[P_STIFF], c[P_DAMP]
-    t0 = c[P_GRAVITY_N] / c[P_PROJ]
+    t0 = c[P_GRAVITY_N] / c[P_PROJ]  # one segment unless a term splits the fibre
     c[D_T0] = t0
     c[D_NSEG] = 1.0
     c[D_K1], c[D_C1], c[D_K2], c[D_C2] = k, damp, k, damp
@@ -102,26 +102,9 @@ def pack(row, knots, coef):  # type: ignore[no-untyped-def]
     # The terms' constants, and the oscillations (for RK4, and what the exponential
     # step leaves) and decays they bring, 1/s: maxima, in any order.
     osc, osc_exp, real = _terms_pack(c, 0.0, 0.0, 0.0)
-    if c[R_PI_ON] > 0.0:  # two segments; the wrapped arc is shared half and half
-        total, l1, l2 = c[R_FIBRE_LEN], c[R_DRIVE_SPAN], c[R_FREE_SPAN]
-        half = 0.5 * (total - l1 - l2)
-        f1, f2 = total / (l1 + half), total / (l2 + half)
-        c[D_NSEG] = 2.0
-        c[D_K1], c[D_C1], c[D_K2], c[D_C2] = k * f1, damp * f1, k * f2, damp * f2
-        c[D_D10], c[D_D20] = t0 / (k * f1), t0 / (k * f2)
-        c[D_KB1], c[D_KB2] = c[D_KB1] * f1, c[D_KB2] * f2  # a branch's k₂ by its length
-        r = c[R_RADIUS]
-        c[D_MP] = c[R_PI_J] / (r * r)
-        c[D_FB0] = c[R_PI_TORQUE] / r
-        c[D_FBL] = c[R_PI_LOAD] * c[R_SIN_HALF_WRAP]
-        c[D_SIGP] = (c[D_FB0] + 2.0 * c[D_FBL] * t0) / c[R_PI_PRESLIDE]
-        stiff = c[D_K1] + c[D_K2] + c[D_KB1] + c[D_KB2] + c[D_SIGP]
-        rim = math.sqrt(stiff / c[D_MP])
-        osc, osc_exp = max(osc, rim), max(osc_exp, rim)
-        c[E_RIM] = (c[D_C1] + c[D_C2]) / c[D_MP]
     c[E_OSC] = osc_exp
     c[D_OSC], c[D_REAL] = osc, real
-    on = c[R_PI_ON] + c[R_X_ON] + _terms_on(c)
+    on = c[R_X_ON] + _terms_on(c)
     c[D_DYN] = 1.0 if on > 0.0 else 0.0
     table = c[P_FRICTION_N] != 0.0 and not _terms_replaces_friction(c)
     c[D_ZONES] = 1.0 if table or _terms_zoned(c) else 0.0
@@ -149,32 +132,27 @@ def _segments(c, y, xa, xb, xd):  # type: ignore[no-untyped-def]
     # <splice branch>
     q1, q2 = _terms_branch(c, y, q1, q2)
     # </splice branch>
-    if not ON_PI or c[D_NSEG] < 1.5:
+    if SEGMENTS < 2 or c[D_NSEG] < 1.5:  # one segment (returning here is 1.8× faster)
         d = c[D_D10] + xa + xb - n * y[Y_U] + (ext1 + ext2)
         dd = xd - n * y[Y_V] + (rate1 + rate2)
         f = c[D_K1] * d + c[D_C1] * dd + q1
         return d, f, d, f, dd, dd
-    d1 = c[D_D10] + xa + xb - y[Y_S] + ext1
-    dd1 = xd - y[Y_SD] + rate1
-    d2 = c[D_D20] + y[Y_S] - n * y[Y_U] + ext2
-    dd2 = y[Y_SD] - n * y[Y_V] + rate2
-    f1 = c[D_K1] * d1 + c[D_C1] * dd1 + q1
-    f2 = c[D_K2] * d2 + c[D_C2] * dd2 + q2
+    # Two: the term that splits the fibre (the pulley's rim between them) gives them.
+    d1, f1, d2, f2, dd1, dd2 = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    # <splice segments>
+    d1, f1, d2, f2, dd1, dd2 = _terms_segments(
+        c, y, xa, xb, xd, n, ext1, rate1, ext2, rate2, q1, q2, d1, f1, d2, f2, dd1, dd2
+    )
+    # </splice segments>
     return d1, f1, d2, f2, dd1, dd2
 
 
 @njit(cache=True, error_model="numpy")
 def _tensions(c, sg):  # type: ignore[no-untyped-def]
     t1 = sg[1] if c[S_TAUT1] > 0.0 else 0.0
-    if not ON_PI or c[D_NSEG] < 1.5:
+    if SEGMENTS < 2 or c[D_NSEG] < 1.5:
         return t1, t1
     return t1, (sg[3] if c[S_TAUT2] > 0.0 else 0.0)
-
-
-@njit(cache=True, error_model="numpy")
-def _bearing_limit(c, t1, t2):  # type: ignore[no-untyped-def]
-    """Largest bearing presliding displacement at these tensions, m."""
-    return (c[D_FB0] + c[D_FBL] * (max(t1, 0.0) + max(t2, 0.0))) / c[D_SIGP]
 
 
 # <added-force>: ``sim.physics.compose`` replaces this function in a composed kernel by
@@ -210,16 +188,8 @@ def _rhs(c, y, xa, xd):  # type: ignore[no-untyped-def]
     if ON_X and c[R_X_ON] > 0.0:
         drive += _added_force(c, y, t2)
     acc = drive / c[P_MASS]
-    s_acc = 0.0
-    if ON_PI and c[D_NSEG] > 1.5:
-        fp = 0.0
-        if c[D_SIGP] > 0.0:
-            zmax = _bearing_limit(c, t1, t2)
-            fp = c[D_SIGP] * min(max(c[S_PZ] + y[Y_S] - c[S_PS0], -zmax), zmax)
-        s_acc = (t1 - t2 - fp) / c[D_MP]
-    sd = y[Y_SD] if ON_PI else 0.0
     # <splice rates>
-    return _terms_rates(c, y, sg, t1, t2, zd, v, acc, sd, s_acc)  # with the terms' rates
+    return _terms_rates(c, y, sg, t1, t2, zd, v, acc)  # with the terms' rates
     # </splice rates>
 
 
@@ -234,11 +204,9 @@ def _set_taut(c, y, x, xd):  # type: ignore[no-untyped-def]
 @njit(cache=True, error_model="numpy")
 def _after_part(c, y, x, xd, h):  # type: ignore[no-untyped-def]
     """Update the discrete states at the end of an integrated part (h seconds) of a step."""
-    if ON_PI and c[D_NSEG] > 1.5 and c[D_SIGP] > 0.0:  # bearing presliding (elasto-plastic)
-        t1, t2 = _tensions(c, _segments(c, y, x, 0.0, xd))
-        zmax = _bearing_limit(c, t1, t2)
-        c[S_PZ] = min(max(c[S_PZ] + y[Y_S] - c[S_PS0], -zmax), zmax)
-        c[S_PS0] = y[Y_S]
+    # <splice settle>
+    _terms_settle(c, y, x, xd, h)
+    # </splice settle>
     # <splice after_part>
     _terms_after_part(c, y, x, xd, h)
     # </splice after_part>
@@ -252,6 +220,6 @@ def _sample_out(c, y, x, xd, i, out_u, out_v, out_t1, out_t2):  # type: ignore[n
     t1 = sg[1] if c[S_TAUT1] > 0.0 else 0.0
     out_t1[i] = t1 if t1 > 0.0 else 0.0
     t2 = t1
-    if ON_PI and c[D_NSEG] > 1.5:
+    if SEGMENTS > 1 and c[D_NSEG] > 1.5:
         t2 = sg[3] if c[S_TAUT2] > 0.0 else 0.0
     out_t2[i] = t2 if t2 > 0.0 else 0.0

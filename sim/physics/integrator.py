@@ -19,7 +19,7 @@ from sim.physics.kernel import (
     MAX_SWITCH,
     NSUB_MAX,
     ON_ANY,
-    ON_PI,
+    SEGMENTS,
     ZERO,
     _axpy,
     _combine,
@@ -179,7 +179,7 @@ def _locate(c, y0, f0, y1, f1, x0, xd, h, which, j):  # type: ignore[no-untyped-
 @njit(cache=True, error_model="numpy")
 def _step(c, y, x0, xd, h):  # type: ignore[no-untyped-def]
     """Advance y by h, splitting the step at every regime switch ."""
-    nseg = 2 if ON_PI and c[D_NSEG] > 1.5 else 1
+    nseg = 2 if SEGMENTS > 1 and c[D_NSEG] > 1.5 else 1
     remaining = h
     xs = x0
     _set_taut(c, y, xs, xd)  # ẋ, and c·δ̇, step at sample boundaries
@@ -250,7 +250,6 @@ def _substeps(c, y, x, xd, dt, base):  # type: ignore[no-untyped-def]
     t_est = 1.5 * max(sg[1], sg[3], 0.0) + c[D_T0]
     osc, osc_exp, real = c[D_OSC], c[E_OSC], c[D_REAL]
     real_exp = real
-    real = max(real, c[E_RIM])  # the rim's damping: exact in the exponential step
     # The terms' rates in this interval (maxima, in any order; see each term's hook).
     # <splice substeps>
     osc, osc_exp, real, real_exp = _terms_substeps(c, y, dt, t_est, osc, osc_exp, real, real_exp)

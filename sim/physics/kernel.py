@@ -1,7 +1,7 @@
 """The compiled model's head: its layout, state helpers and constants (source text only).
 
-The model is one text in four parts — this head, ``fibre`` (the fibre, the weight, the
-pulley's second segment: constants, forces, right-hand side), ``integrator`` (RK4 /
+The model is one text in four parts — this head, ``fibre`` (the fibre in one segment or
+two, the weight, the friction table: constants, forces, right-hand side), ``integrator`` (RK4 /
 ETDRK4 steps split at located events, substeps) and ``runners`` (from rest, batch,
 segments, chained, block by block) — then each composed term's ``terms.py``. It is never
 imported as itself: ``sim.physics.compose`` writes it, composed for a set of terms, into
@@ -42,8 +42,8 @@ exponential step (``_etdrk4``) where it pays.
 
 Speed: the hot functions take c and scalars or tuples only; passing arrays to small
 jitted functions costs 7 machine words per array per call (measured: 60 → 9 ms for 10 s
-at 2 kHz). A term that is out of the set is not written in, and the pulley's branches
-are pruned at compile time (``ON_PI``), so the baseline runs on two states without the
+at 2 kHz). A term that is out of the set is not written in, and the second segment's
+branches are pruned at compile time (``SEGMENTS``), so the baseline runs on two states without the
 terms' branches. The hooks on the right-hand side's path are written in place, not
 called (``kernel_source.SPLICED``: called, they made the union 3–4.5× slower). All numba
 code of the model is composed into one text on purpose: numba's cache does not notice
@@ -66,6 +66,7 @@ from sim.physics.layout import *
 
 # Which terms the set composes (1: in): a term that is out is pruned at compile time.
 ON_VE, ON_TV, ON_PJ, ON_PI, ON_SS, ON_SL, ON_X, ON_ANY = 1, 1, 1, 1, 1, 1, 1, 1
+SEGMENTS = 2  # the most fibre segments the set has (the pulley's rim splits the fibre)
 # </layout>
 
 # <state>: ``kernel_source.state_block`` writes the set's tuple helpers here; what follows
@@ -181,6 +182,15 @@ from sim.effects.fibre_transverse_vibration.terms import (
     tv_substeps,
 )
 from sim.effects.fibre_viscoelastic.terms import ve_branch, ve_pack, ve_rates, ve_start_state
+from sim.effects.pulley_inertia_friction.terms import (
+    pi_pack,
+    pi_rates,
+    pi_segments,
+    pi_settle,
+    pi_start,
+    pi_start_state,
+    pi_substeps,
+)
 from sim.effects.side_load_friction.terms import sl_friction, sl_pack, sl_substeps, sl_zoned
 from sim.effects.stick_slip_friction.terms import (
     ss_decay,
@@ -196,7 +206,7 @@ from sim.effects.stick_slip_friction.terms import (
 @njit(cache=True, error_model="numpy")
 def _terms_on(c):  # type: ignore[no-untyped-def]
     """How many of the composed terms are on (> 0: any)."""
-    return 0.0 + c[R_VE_ON] + c[R_TV_ON] + c[R_PJ_ON] + c[R_SS_ON] + c[R_SL_ON]
+    return 0.0 + c[R_VE_ON] + c[R_TV_ON] + c[R_PJ_ON] + c[R_PI_ON] + c[R_SS_ON] + c[R_SL_ON]
 
 
 @njit(cache=True, error_model="numpy")
@@ -204,6 +214,7 @@ def _terms_pack(c, osc, osc_exp, real):  # type: ignore[no-untyped-def]
     """The composed terms' ``pack`` hooks."""
     osc, osc_exp, real = ve_pack(c, osc, osc_exp, real)
     osc, osc_exp, real = tv_pack(c, osc, osc_exp, real)
+    osc, osc_exp, real = pi_pack(c, osc, osc_exp, real)
     osc, osc_exp, real = ss_pack(c, osc, osc_exp, real)
     osc, osc_exp, real = sl_pack(c, osc, osc_exp, real)
     return osc, osc_exp, real
@@ -267,6 +278,7 @@ def _terms_decay(c, v, rate):  # type: ignore[no-untyped-def]
 def _terms_substeps(c, y, dt, t_est, osc, osc_exp, real, real_exp):  # type: ignore[no-untyped-def]
     """The composed terms' ``substeps`` hooks."""
     osc, osc_exp, real, real_exp = tv_substeps(c, y, dt, t_est, osc, osc_exp, real, real_exp)
+    osc, osc_exp, real, real_exp = pi_substeps(c, y, dt, t_est, osc, osc_exp, real, real_exp)
     osc, osc_exp, real, real_exp = ss_substeps(c, y, dt, t_est, osc, osc_exp, real, real_exp)
     osc, osc_exp, real, real_exp = sl_substeps(c, y, dt, t_est, osc, osc_exp, real, real_exp)
     return osc, osc_exp, real, real_exp
@@ -300,9 +312,27 @@ def _terms_given_end(c):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True, error_model="numpy")
-def _terms_start(c, m):  # type: ignore[no-untyped-def]
+def _terms_start(c, y, x, xd, m):  # type: ignore[no-untyped-def]
     """The composed terms' ``start`` hooks."""
-    pj_start(c, m)
+    pj_start(c, y, x, xd, m)
+    pi_start(c, y, x, xd, m)
+
+
+@njit(cache=True, error_model="numpy")
+def _terms_segments(  # type: ignore[no-untyped-def]
+    c, y, xa, xb, xd, n, ext1, rate1, ext2, rate2, q1, q2, d1, f1, d2, f2, dd1, dd2
+):
+    """The composed terms' ``segments`` hooks."""
+    d1, f1, d2, f2, dd1, dd2 = pi_segments(
+        c, y, xa, xb, xd, n, ext1, rate1, ext2, rate2, q1, q2, d1, f1, d2, f2, dd1, dd2
+    )
+    return d1, f1, d2, f2, dd1, dd2
+
+
+@njit(cache=True, error_model="numpy")
+def _terms_settle(c, y, x, xd, h):  # type: ignore[no-untyped-def]
+    """The composed terms' ``settle`` hooks."""
+    pi_settle(c, y, x, xd, h)
 
 
 @njit(cache=True, error_model="numpy")
@@ -318,7 +348,7 @@ def _terms_rest(c):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True, error_model="numpy")
-def _terms_rates(c, y, sg, t1, t2, zd, v, acc, sd, s_acc):  # type: ignore[no-untyped-def]
+def _terms_rates(c, y, sg, t1, t2, zd, v, acc):  # type: ignore[no-untyped-def]
     """The whole state: the composed terms' ``rates`` hooks give their own."""
     (
         r_q1,
@@ -330,12 +360,16 @@ def _terms_rates(c, y, sg, t1, t2, zd, v, acc, sd, s_acc):  # type: ignore[no-un
         r_a2,
         r_ad2,
     ) = tv_rates(c, y, sg, t1, t2, zd)
+    (
+        r_s,
+        r_sd,
+    ) = pi_rates(c, y, sg, t1, t2, zd)
     (r_z,) = ss_rates(c, y, sg, t1, t2, zd)
-    return _state(v, acc, sd, s_acc, r_q1, r_q2, r_a1, r_ad1, r_a2, r_ad2, r_z)
+    return _state(v, acc, r_s, r_sd, r_q1, r_q2, r_a1, r_ad1, r_a2, r_ad2, r_z)
 
 
 @njit(cache=True, error_model="numpy")
-def _terms_start_state(c, x, xd, u, v, force, taut, m, s, sd):  # type: ignore[no-untyped-def]
+def _terms_start_state(c, x, xd, u, v, force, taut, m):  # type: ignore[no-untyped-def]
     """The whole state: the composed terms' ``start_state`` hooks give their own."""
     (
         r_q1,
@@ -347,8 +381,12 @@ def _terms_start_state(c, x, xd, u, v, force, taut, m, s, sd):  # type: ignore[n
         r_a2,
         r_ad2,
     ) = tv_start_state(c, x, xd, u, v, force, taut, m)
+    (
+        r_s,
+        r_sd,
+    ) = pi_start_state(c, x, xd, u, v, force, taut, m)
     (r_z,) = ss_start_state(c, x, xd, u, v, force, taut, m)
-    return _state(u, v, s, sd, r_q1, r_q2, r_a1, r_ad1, r_a2, r_ad2, r_z)
+    return _state(u, v, r_s, r_sd, r_q1, r_q2, r_a1, r_ad1, r_a2, r_ad2, r_z)
 
 
 # </hooks>

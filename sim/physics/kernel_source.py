@@ -57,24 +57,23 @@ HOOKS: dict[str, tuple[tuple[str, ...], tuple[str, ...] | None]] = {
     "given_start": (("c", "given"), None),  # follows a recorded input this run
     "given_at": (("c", "value"), ()),  # the input over the next interval
     "given_end": (("c",), ()),
-    "start": (("c", "m"), ()),  # discrete state at a measured start
+    "start": (("c", "y", "x", "xd", "m"), ()),  # discrete state at a measured start
+    # a term that splits the fibre: each segment's (δ, F, δ̇)
+    "segments": (
+        ("c", "y", "xa", "xb", "xd", "n", "ext1", "rate1", "ext2", "rate2", "q1", "q2",
+         "d1", "f1", "d2", "f2", "dd1", "dd2"),
+        ("d1", "f1", "d2", "f2", "dd1", "dd2"),
+    ),
+    "settle": (("c", "y", "x", "xd", "h"), ()),  # discrete state after a part, first
 }  # fmt: skip
 #: The hooks that give a term's own states (``layout.STATES``, in their order): its
 #: values at rest, their rates, their values at a measured start. The composed set's
 #: ``_terms_<hook>`` builds the whole state: the extra arguments give the baseline's
 #: (and the pulley rim's) entries, a term not composed in gives zeros.
 STATE_HOOKS: dict[str, tuple[tuple[str, ...], tuple[str, ...], dict[str, str]]] = {
-    "rest": (("c",), (), {"U": "0.0", "V": "0.0", "S": "0.0", "SD": "0.0"}),
-    "rates": (
-        ("c", "y", "sg", "t1", "t2", "zd"),
-        ("v", "acc", "sd", "s_acc"),
-        {"U": "v", "V": "acc", "S": "sd", "SD": "s_acc"},
-    ),
-    "start_state": (
-        ("c", "x", "xd", "u", "v", "force", "taut", "m"),
-        ("s", "sd"),
-        {"U": "u", "V": "v", "S": "s", "SD": "sd"},
-    ),
+    "rest": (("c",), (), {"U": "0.0", "V": "0.0"}),
+    "rates": (("c", "y", "sg", "t1", "t2", "zd"), ("v", "acc"), {"U": "v", "V": "acc"}),
+    "start_state": (("c", "x", "xd", "u", "v", "force", "taut", "m"), (), {"U": "u", "V": "v"}),
 }
 
 
@@ -83,7 +82,10 @@ STATE_HOOKS: dict[str, tuple[tuple[str, ...], tuple[str, ...], dict[str, str]]] 
 #: parts instead of being called. A call there that passes the state tuple kept numba
 #: and LLVM from simplifying the segments' and forces' arithmetic (measured: the union
 #: ran 3–4.5× slower with these hooks called, even with ``inline="always"``).
-SPLICED = ("extension", "branch", "friction_law", "friction", "rates", "after_part", "substeps")
+SPLICED = (
+    "extension", "branch", "segments", "friction_law", "friction", "rates", "settle",
+    "after_part", "substeps",
+)  # fmt: skip
 
 
 def term_files(terms: tuple[str, ...]) -> list[tuple[str, Path]]:
@@ -108,6 +110,14 @@ def text(terms: tuple[str, ...] = layout.TERMS) -> str:
     texts += [_body(here / name) for name in PARTS]
     texts += [_body(path) for _, path in term_files(terms)]
     return "\n".join(texts)
+
+
+def _def(name: str, args: tuple[str, ...]) -> list[str]:
+    """A def line (wrapped as the formatter wraps it, the annotation comment kept on top)."""
+    line = f"def {name}({', '.join(args)}):  # type: ignore[no-untyped-def]"
+    if len(line) <= 100:
+        return [line]
+    return [f"def {name}(  # type: ignore[no-untyped-def]", f"    {', '.join(args)}", "):"]
 
 
 def hooks_block(terms: tuple[str, ...]) -> str:
@@ -137,7 +147,7 @@ def hooks_block(terms: tuple[str, ...]) -> str:
             body.append(f"    return {out}")
         else:
             body += [f"    {func}({call_args})" for func in calls] or ["    return"]
-        lines += ["", "", _NJIT, f"def _terms_{hook}({call_args}):  # type: ignore[no-untyped-def]",
+        lines += ["", "", _NJIT, *_def(f"_terms_{hook}", args),
                   f'    """The composed terms\' ``{hook}`` hooks."""', *body]  # fmt: skip
     for hook, (args, extra, given) in STATE_HOOKS.items():
         body = []
@@ -151,8 +161,7 @@ def hooks_block(terms: tuple[str, ...]) -> str:
                 value.update({n.upper(): f"r_{n}" for n in own})
         every = ", ".join(value.get(name, "0.0") for name, _ in layout.STATES)
         doc = f"The whole state: the composed terms' ``{hook}`` hooks give their own."
-        signature = ", ".join(args + extra)
-        lines += ["", "", _NJIT, f"def _terms_{hook}({signature}):  # type: ignore[no-untyped-def]",
+        lines += ["", "", _NJIT, *_def(f"_terms_{hook}", args + extra),
                   f'    """{doc}"""', *body, f"    return _state({every})"]  # fmt: skip
     return "\n".join(lines) + "\n\n\n"
 
@@ -262,7 +271,6 @@ def splice_sites(source: str, terms: tuple[str, ...]) -> str:
         site = source[start:end]
         indent = source[source.rindex("\n", 0, start) + 1 : start]
         lines = site.split("\n")
-        call = next(i for i, line in enumerate(lines) if f"_terms_{hook}(" in line)
         written: list[str] = []
         if hook in HOOKS:
             args, passed = HOOKS[hook]
@@ -282,6 +290,7 @@ def splice_sites(source: str, terms: tuple[str, ...]) -> str:
                     value.update({n: f"r_{n.lower()}" for n in own})
             every = ", ".join(value.get(name, "0.0") for name, _ in layout.STATES)
             written.append(f"return _state({every})")
-        lines[call] = "\n".join(indent + line if line else line for line in written) or indent
-        source = source[:start] + "\n".join(lines) + source[end:]
+        # The marker, the written bodies in place of the call's statement, the indent.
+        body = [indent + line if line else line for line in written]
+        source = source[:start] + "\n".join([lines[0], *body, lines[-1]]) + source[end:]
     return source

@@ -122,5 +122,7 @@ def constants(terms: tuple[str, ...], added: bool) -> dict[str, int]:
     for symbol in TERMS:
         values[f"ON_{symbol}"] = int(symbol in terms)
     values["ON_X"] = int(added)
+    # The most fibre segments the set has: the pulley's rim splits the fibre in two.
+    values["SEGMENTS"] = 2 if "PI" in terms else 1
     values["ON_ANY"] = int(bool(terms) or added)
     return values

@@ -11,20 +11,10 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from sim.physics.fibre import (
-    _bearing_limit,
-    _sample_out,
-    _segments,
-    _set_taut,
-    _tensions,
-    _zone,
-    pack,
-    rest_state,
-)
+from sim.physics.fibre import _sample_out, _set_taut, _zone, pack, rest_state
 from sim.physics.integrator import _step, _substeps
 from sim.physics.kernel import (
     NCARRY,
-    ON_PI,
     _carry_out,
     _terms_given_at,
     _terms_given_end,
@@ -116,33 +106,16 @@ def measured_state(c, x, xd, m):  # type: ignore[no-untyped-def]
     """A full state from a measured start m (columns I_*) at drive x (m), rate xd (m/s).
 
     Measured: weight u (m), v (m/s) and the drive-side force F (N). The effects' own
-    states are not measured and take quasi-static values: pulley rim where the drive-side
-    segment carries the measured F (taut) or both segments equal tension (slack), moving
-    with the fibre, bearing presliding holding the tension difference (within its limit);
-    each term's from its ``start_state`` hook (its continuous states, from the measured
+    states are not measured and take quasi-static values, each term's from its
+    ``start_state`` hook (its continuous states, from the measured
     values and the columns the caller filled, e.g. I_HP) and its ``start`` hook (its
     discrete state in c); ``simulate_chained_into`` replaces the carried ones by the
     previous segment's. Sets the discrete state in c; returns the continuous state tuple.
     """
     u, v, force = m[I_U], m[I_V], m[I_F]
-    n = c[P_PROJ]
     taut = force > 0.25 * c[D_T0]
-    s, sd = 0.0, 0.0
-    if ON_PI and c[D_NSEG] > 1.5:
-        k1, k2 = c[D_K1], c[D_K2]
-        sd = (k1 * xd + k2 * n * v) / (k1 + k2)
-        if taut:
-            s = c[D_D10] + x - (force - c[D_C1] * (xd - sd)) / k1
-        else:
-            s = (k1 * (c[D_D10] + x) - k2 * (c[D_D20] - n * u)) / (k1 + k2)
-    y = _terms_start_state(c, x, xd, u, v, force, taut, m, s, sd)  # the terms' own
-    _terms_start(c, m)
-    c[S_PZ], c[S_PS0] = 0.0, s
-    if ON_PI and c[D_NSEG] > 1.5 and c[D_SIGP] > 0.0:
-        _set_taut(c, y, x, xd)
-        t1, t2 = _tensions(c, _segments(c, y, x, 0.0, xd))
-        zmax = _bearing_limit(c, t1, t2)
-        c[S_PZ] = min(max((t1 - t2) / c[D_SIGP], -zmax), zmax)
+    y = _terms_start_state(c, x, xd, u, v, force, taut, m)  # the terms' own states
+    _terms_start(c, y, x, xd, m)  # and their discrete states
     return y
 
 

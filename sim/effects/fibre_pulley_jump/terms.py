@@ -61,7 +61,7 @@ def pj_given_end(c):  # type: ignore[no-untyped-def]
 
 
 @njit(cache=True, error_model="numpy")
-def pj_start(c, m):  # type: ignore[no-untyped-def]
+def pj_start(c, y, x, xd, m):  # type: ignore[no-untyped-def]
     """The seat at a segment's measured start (``measured_seats``, in m's I_LOFF … I_SLACKT).
 
     From the recorded slack episodes: a seat estimated from the measured elongation at
