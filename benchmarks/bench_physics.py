@@ -56,7 +56,7 @@ def best_of(fn: Callable[[], object], repeats: int) -> list[float]:
     return [min(walls), min(cpus)]
 
 
-def measure(seconds: float) -> dict[str, list[float]]:
+def measure(seconds: float, cases: list[str]) -> dict[str, list[float]]:
     """{case: [run, run CPU, batch, batch CPU] (s)} in this process (its tree on sys.path)."""
     import numpy as np
 
@@ -73,7 +73,8 @@ def measure(seconds: float) -> dict[str, list[float]]:
     _, x = plan_motion(spec, stand.drive).sample(RATE)
     params = stand.stand_params("final", s11.mass_kg)
     out = {}
-    for case, (effects, batch) in CASES.items():
+    for case in cases:
+        effects, batch = CASES[case]
         rng = np.random.default_rng(1)
         variants = [
             {
@@ -114,13 +115,13 @@ def cold() -> dict[str, list[float]]:
 
 
 def child(
-    tree: Path, mode: str, seconds: float, cache: str | None = None
+    tree: Path, mode: str, seconds: float, cache: str | None = None, cases: str = ""
 ) -> dict[str, list[float]]:
     """``measure`` (or ``cold``) in a fresh process with ``tree`` first on its path."""
     env = {**os.environ, "PYTHONPATH": str(tree)}
     if cache is not None:
         env |= {"NUMBA_CACHE_DIR": cache, "LABSTAND_KERNEL_CACHE": str(Path(cache) / "kernels")}
-    argv = [sys.executable, __file__, f"--{mode}-child", str(seconds)]
+    argv = [sys.executable, __file__, f"--{mode}-child", str(seconds), cases or ",".join(CASES)]
     done = subprocess.run(argv, env=env, cwd=tree, capture_output=True, text=True, check=False)
     if done.returncode != 0:
         raise SystemExit(f"measuring {tree} failed:\n{done.stderr}")
@@ -129,16 +130,18 @@ def child(
 
 
 def main() -> None:
-    if len(sys.argv) == 3 and sys.argv[1] in ("--measure-child", "--cold-child"):
-        fn = measure if sys.argv[1] == "--measure-child" else (lambda _: cold())
-        print(json.dumps(fn(float(sys.argv[2]))))
+    if len(sys.argv) == 4 and sys.argv[1] in ("--measure-child", "--cold-child"):
+        seconds, cases = float(sys.argv[2]), sys.argv[3].split(",")
+        print(json.dumps(measure(seconds, cases) if "measure" in sys.argv[1] else cold()))
         return
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--before", type=Path, help="another source tree to measure alike")
     parser.add_argument("--rounds", type=int, default=2)
     parser.add_argument("--seconds", type=float, default=60.0, help="simulated duration, s")
     parser.add_argument("--cold", action="store_true", help="also time a compile from empty")
+    parser.add_argument("--cases", default="", help="comma-separated cases (default: all)")
     args = parser.parse_args()
+    cases = [c for c in args.cases.split(",") if c] or list(CASES)
     trees = {"now": HERE} | ({"before": args.before.resolve()} if args.before else {})
     if args.cold:
         for label, tree in reversed(trees.items()):
@@ -149,13 +152,13 @@ def main() -> None:
                     f"cold compile, {label}: {wall:.1f} s wall, {cpu:.1f} s CPU (load {load:.1f})"
                 )
     for tree in trees.values():
-        child(tree, "measure", 2.0)  # warm numba's cache in each tree
+        child(tree, "measure", 2.0, cases=",".join(cases))  # warm numba's cache in each tree
     best: dict[str, dict[str, list[float]]] = {}
     loads = []
     for _ in range(args.rounds):
         for label, tree in reversed(trees.items()):  # before, now, before, now, ...
             loads.append(os.getloadavg()[0])
-            for case, times in child(tree, "measure", args.seconds).items():
+            for case, times in child(tree, "measure", args.seconds, cases=",".join(cases)).items():
                 old = best.setdefault(label, {}).setdefault(case, times)
                 best[label][case] = [min(a, b) for a, b in zip(old, times, strict=True)]
     print(f"load average during the rounds: {min(loads):.1f}–{max(loads):.1f} (2 cores)")
@@ -164,7 +167,8 @@ def main() -> None:
         + (" run vs before | batch vs before |" if "before" in best else "")
     )
     print("|---|---|---|---|---|" + ("---|---|" if "before" in best else ""))
-    for case, (_, size) in CASES.items():
+    for case in cases:
+        size = CASES[case][1]
         for label in trees:
             run, run_cpu, batch, batch_cpu = best[label][case]
             row = f"| {case}, {label} (batch {size}) | {run * 1e3:.1f} | {run_cpu * 1e3:.1f} | "

@@ -198,28 +198,27 @@ def simulate_rows(
     sets, n = rows2.shape[0], x2.shape[1]
     if x2.shape[0] not in (1, sets):
         raise EffectError(f"drive rows ({x2.shape[0]}) must be 1 or one per set ({sets})")
-    u, v = np.empty((sets, n)), np.empty((sets, n))
-    t1, t2 = np.empty((sets, n)), np.empty((sets, n))
+    kernel = _kernel(rows2)
+    u, v, t1 = np.empty((sets, n)), np.empty((sets, n)), np.empty((sets, n))
+    # With one segment the weight side's tension is the drive side's: the runner writes
+    # the same value twice into one array (256 sets of a 60 s run: 250 MB less to touch,
+    # 9 % of the batch's time).
+    t2 = t1 if kernel.SEGMENTS < 2 else np.empty((sets, n))
     knots, coef = friction_arrays(table)
     dt = 1.0 / rate_hz
-    _kernel(rows2).simulate_batch_into(x2, dt, substeps, rows2, knots, coef, u, v, t1, t2)
+    kernel.simulate_batch_into(x2, dt, substeps, rows2, knots, coef, u, v, t1, t2)
+    t = np.arange(n) / rate_hz
+    mrows = measure.measurement_rows(rows2)
+    if not _gauged(mrows):
+        return BatchResult(t, u, v, t1, u, t1)  # no gauge effect: recorded = true
     rec_u, rec_f = np.empty_like(u), np.empty_like(t1)
-    measure.measure_batch_into(
-        u, t1, dt, measure.measurement_rows(rows2), _settled(sets), rec_u, rec_f
-    )
-    return BatchResult(np.arange(n) / rate_hz, rec_u, v, rec_f, u, t1)
+    measure.measure_batch_into(u, t1, dt, mrows, _settled(sets), rec_u, rec_f)
+    return BatchResult(t, rec_u, v, rec_f, u, t1)
 
 
-def measure_outputs(
-    u: FloatArray, force: FloatArray, rate_hz: float, rows: FloatArray
-) -> tuple[FloatArray, FloatArray]:
-    """Recorded u (m), F (N) of whole runs (sets, samples): the rows' gauge effects."""
-    out_u, out_f = np.empty_like(u), np.empty_like(force)
-    measure.measure_batch_into(
-        np.ascontiguousarray(u), np.ascontiguousarray(force), 1.0 / rate_hz,
-        measure.measurement_rows(rows), _settled(u.shape[0]), out_u, out_f,
-    )  # fmt: skip
-    return out_u, out_f
+def _gauged(mrows: FloatArray) -> bool:
+    """Whether any measurement row has a gauge effect on (else the channels are the true)."""
+    return bool(mrows[:, [measure.M_DG_ON, measure.M_FG_ON, measure.M_CS_ON]].any())
 
 
 def measure_segments(
@@ -240,7 +239,7 @@ def measure_segments(
     """
     sets, segs, width = u.shape
     mrows = measure.measurement_rows(rows)
-    if not mrows[:, [measure.M_DG_ON, measure.M_FG_ON, measure.M_CS_ON]].any():
+    if not _gauged(mrows):
         return u, force  # no gauge effect: the recorded channels are the true ones
     m = np.repeat(mrows, segs, axis=0)
     gauge0 = np.ascontiguousarray(init[:, :, [layout.I_F, layout.I_FRATE]], dtype=np.float64)
