@@ -1,4 +1,4 @@
-"""Benchmark: the effects' kernel (sim.effects.kernel) now and in another source tree.
+"""Benchmark: the model with effects (the union of the built-in terms) now and in another tree.
 
     .venv/bin/python benchmarks/bench_effect_kernel.py [--before SRC_TREE] [--rounds 2]
 

@@ -32,11 +32,11 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # the added effect is in tests/
 
 from drivers.signals import SignalSpec, plan_motion
-from sim import _baseline
 from sim.config import default_config
 from sim.effects import EffectSpec, register, unregister
 from sim.model import Model, Variant
 from sim.params import StandParams
+from sim.physics import runs
 from sim.reference import solve_reference
 from sim.situations import situation
 from tests.effects import weight_viscous_damping
@@ -149,7 +149,7 @@ def main() -> None:
     model = Model(params)
     model.run(x[:100], RATE)  # compile (cached after the first run)
     single = best_of(lambda: model.run(x, RATE), 5)
-    direct = best_of(lambda: _baseline.simulate(x, RATE, params), 5)
+    direct = best_of(lambda: runs.simulate(x, RATE, params), 5)
     run = model.run(x, RATE)
     print(
         f"kernel, single: {single * 1e3:8.1f} ms  -> {sim_s / single:8.0f}x real time "
@@ -168,9 +168,9 @@ def main() -> None:
     ]
     model.run_batch(x[:100], RATE, variants[:2])
     batch = best_of(lambda: model.run_batch(x, RATE, variants), 2)
-    rows = np.stack([_baseline.param_vector(params.with_(**v)) for v in variants])
+    rows = np.stack([runs.parameter_row(params.with_(**v)) for v in variants])
     rel = x - x[0]
-    direct_batch = best_of(lambda: _baseline.simulate_rows(rel, RATE, rows, params.friction), 2)
+    direct_batch = best_of(lambda: runs.simulate_rows(rel, RATE, rows, params.friction), 2)
     print(
         f"kernel, batch of {args.batch}: {batch:8.2f} s  -> {args.batch * sim_s / batch:8.0f}x "
         f"real time ({batch / args.batch * 1e3:.1f} ms per set)"

@@ -9,10 +9,10 @@ replay, the simulated stand's gauges and the diagnosis alike::
     u, f = model.run_segments(x_m, rate_hz, restarts, variants)  # multiple shooting
     stream = model.stream(rate_hz)                       # block by block, in real time
 
-The model alone decides how: without physical effects it runs the baseline's fast kernel
-(``sim.kernel``), with them the augmented kernel (``sim.effects.kernel``, or a copy
-composed with the forces of effects added by ``register``: ``sim.effects._compose``);
-measurement effects (gauge calibration, skew, gauge dynamics) then transform the
+The model alone decides how: every run goes through one compiled model
+(``sim.physics``) composed for its terms — none without physical effects (the
+baseline), else the built-in union with the forces of effects added by ``register`` —
+and measurement effects (gauge calibration, skew, gauge dynamics) then transform the
 outputs. Segment runs restart from measured channels: the model inverts its own gauge
 effects to get the true state, sets the effects' states from the measurements, and
 carries over from the previous segment the states the gauges cannot see (string modes,
@@ -32,12 +32,11 @@ from typing import Protocol
 import numpy as np
 from numpy.typing import NDArray
 
-from sim import _baseline
-from sim._baseline import DEFAULT_SUBSTEPS, check_input
-from sim.effects import _augmented, _starts
 from sim.effects.registry import EFFECTS, EffectError, EffectSpec, check_unique
 from sim.errors import SimulationError
 from sim.params import StandParams
+from sim.physics import runs, starts
+from sim.physics.runs import DEFAULT_SUBSTEPS, check_input
 from sim.results import BatchResult, ModelRun, SimResult
 
 FloatArray = NDArray[np.float64]
@@ -132,7 +131,7 @@ class Model:
         self.effects = tuple(effects)
         self.substeps = substeps
         kinds = {EFFECTS[e.name].kind for e in self.effects}
-        #: Physical effects change the dynamics: the augmented kernel runs.
+        #: Physical effects change the dynamics: the union of the built-in terms runs.
         self.physical = "physical" in kinds
         #: Measurement effects transform the outputs.
         self.measured = "measurement" in kinds
@@ -165,22 +164,13 @@ class Model:
         stand = self.stand.with_(**stand_changes) if stand_changes else self.stand
         return Model(stand, effects, self.substeps)
 
-    def _rows(
-        self, variants: Sequence[Variant], augmented: bool = False
-    ) -> tuple[FloatArray, FloatArray]:
-        """(baseline kernel rows, augmented rows) of the variants.
-
-        The augmented rows are built only where needed (effects, or ``augmented``); else
-        the baseline rows stand in for them.
-        """
+    def _rows(self, variants: Sequence[Variant]) -> FloatArray:
+        """The kernel's parameter rows of the variants (``runs.parameter_row``)."""
         models = [self.variant(v) if v else self for v in variants]
         tables = {m.stand.friction for m in models}
         if len(tables) > 1:
             raise SimulationError("a batch must share one friction table (vary friction_scale)")
-        base = np.stack([_baseline.param_vector(m.stand) for m in models])
-        if not (self.physical or self.measured or augmented):
-            return base, base
-        return base, np.stack([_augmented.augmented_row(m.stand, m.effects) for m in models])
+        return np.stack([runs.parameter_row(m.stand, m.effects) for m in models])
 
     # -- runs -----------------------------------------------------------------------
     def run(self, x_m: FloatArray, rate_hz: float) -> ModelRun:
@@ -188,15 +178,7 @@ class Model:
 
         Returns the recorded u and F (after the gauge effects) and the true channels.
         """
-        if self.effects:
-            return _augmented.simulate_augmented(
-                x_m, rate_hz, self.stand, self.effects, self.substeps
-            )
-        res = _baseline.simulate(x_m, rate_hz, self.stand, self.substeps)
-        return ModelRun(
-            res.t_s, res.x_m, res.u_m, res.v_m_s, res.force_n, res.preload_tension_n,
-            res.u_m, res.force_n, res.force_n, self.substeps,
-        )  # fmt: skip
+        return runs.simulate(x_m, rate_hz, self.stand, self.effects, self.substeps)
 
     def run_batch(
         self, x_m: FloatArray, rate_hz: float, variants: Sequence[Variant] = ({},)
@@ -215,15 +197,8 @@ class Model:
             raise SimulationError(
                 f"drive rows ({x.shape[0]}) must be 1 or one per set ({len(variants)})"
             )
-        base, rows = self._rows(variants)
-        table = self.stand.friction
-        if self.physical:
-            return _augmented.simulate_augmented_rows(rel, rate_hz, rows, table, self.substeps)
-        res = _baseline.simulate_rows(rel, rate_hz, base, table, self.substeps)
-        if not self.measured:
-            return res
-        u, f = _augmented.measure_outputs(res.u_m, res.force_n, rate_hz, rows)
-        return BatchResult(res.t_s, u, res.v_m_s, f, res.u_m, res.force_n)
+        rows = self._rows(variants)
+        return runs.simulate_rows(rel, rate_hz, rows, self.stand.friction, self.substeps)
 
     def run_segments(
         self,
@@ -241,24 +216,15 @@ class Model:
         traces can run side by side (one thread each) instead of each on all cores.
         """
         x_rel = check_input(x_m, rate_hz)
-        base, rows = self._rows(variants, augmented=True)  # the start states need them
-        init, seats = _starts.start_states(
+        rows = self._rows(variants)
+        init, seats = starts.start_states(
             rows, x_rel, rate_hz, restarts.starts, restarts.u_m, restarts.v_m_s,
             restarts.force_n, restarts.dial_slope,
         )  # fmt: skip
-        table = self.stand.friction
-        starts, lengths = restarts.starts, restarts.lengths
-        if self.physical:
-            return _augmented.simulate_augmented_segments(
-                x_rel, rate_hz, rows, table, starts, lengths, init, self.substeps,
-                chained=self.chained, serial=serial, seats=seats,
-            )  # fmt: skip
-        u, f = _baseline.simulate_segment_rows(
-            x_rel, rate_hz, base, table, starts, lengths, init[:, :, :2], self.substeps, serial
-        )
-        if self.measured:
-            return _augmented.measure_segments(u, f, rate_hz, rows, starts, init)
-        return u, f
+        return runs.simulate_segments(
+            x_rel, rate_hz, rows, self.stand.friction, restarts.starts, restarts.lengths, init,
+            self.substeps, chained=self.chained, serial=serial, seats=seats,
+        )  # fmt: skip
 
     def stream(self, rate_hz: float, x0_m: float = 0.0) -> ModelStream:
         """The model at static rest with the drive at ``x0_m``, advanced block by block.
@@ -266,8 +232,4 @@ class Model:
         Equal to one ``run`` over the concatenated blocks. A stream cannot look ahead, so
         a negative channel skew (a channel recorded early) is refused.
         """
-        if self.effects:
-            return _augmented.AugmentedStream(
-                self.stand, rate_hz, self.effects, x0_m, self.substeps
-            )
-        return _baseline.BaselineStream(self.stand, rate_hz, x0_m, self.substeps)
+        return runs.Stream(self.stand, rate_hz, self.effects, x0_m, self.substeps)

@@ -9,7 +9,6 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from sim.effects import kernel as ek
 from sim.effects.info import EffectInfo, param
 
 FloatArray = NDArray[np.float64]
@@ -29,7 +28,9 @@ def _true_channels(
         at = np.arange(series.size) + delay_s * rate_hz
         return np.asarray(np.interp(at, np.arange(series.size), series), dtype=np.float64)
 
-    displacement, force = row[ek.R_CS_DISP], row[ek.R_CS_FORCE]
+    from sim.physics import layout  # the registry's columns (it imports this module)
+
+    displacement, force = row[layout.R_CS_DISP], row[layout.R_CS_FORCE]
     return shifted(u_m, displacement), shifted(v_m_s, displacement), shifted(force_n, force)
 
 
@@ -39,13 +40,13 @@ INFO = EffectInfo(
     "channel_time_skew", "measurement",
     "a channel is sampled Δt late (Δt < 0: early) against the drive channel",
     "residual ∝ the channel's derivative; cross-correlation peak off zero",
-    ek.R_CS_ON,
+    "CS",
     (
-        param("force_skew_s", "s", 1.0e-3, (-3.0e-3, 3.0e-3), (-0.05, 0.05), ek.R_CS_FORCE,
+        param("force_skew_s", "s", 1.0e-3, (-3.0e-3, 3.0e-3), (-0.05, 0.05), "FORCE",
               "delay of the force channel", log=True, bounds=(-0.025, 0.025),
               why="separate buffers, serial latency and filter delays: up to 50 samples "
                   "(25 ms) either way at 2 kHz"),
-        param("displacement_skew_s", "s", 0.0, (-3.0e-3, 3.0e-3), (-0.05, 0.05), ek.R_CS_DISP,
+        param("displacement_skew_s", "s", 0.0, (-3.0e-3, 3.0e-3), (-0.05, 0.05), "DISP",
               "delay of the displacement channel", log=True, bounds=(-0.025, 0.025),
               why="as the force channel's"),
     ),

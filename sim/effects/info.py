@@ -64,7 +64,7 @@ class Measured:
     force_n: FloatArray
 
 
-#: Fills an effect's columns of ``init`` (segments, ``kernel.N_INIT``) for one kernel row:
+#: Fills an effect's columns of ``init`` (segments, ``layout.N_INIT``) for one kernel row:
 #: ``start_state(row, measured, starts, init)``.
 StartState = Callable[[FloatArray, Measured, IntArray, FloatArray], None]
 #: A gauge effect's inverse: ``true_channels(row, rate_hz, u, v, force)`` → (u, v, force)
@@ -87,7 +87,8 @@ class ParamInfo:
     minimum: float
     maximum: float
     description: str
-    column: int  # index in the kernel's parameter row
+    #: Its name in the kernel (``R_<effect symbol>_<symbol>``, ``sim.physics.layout``).
+    symbol: str
     fit: bool = True  # worth fitting in a diagnosis (else a fixed physical constant)
     #: Spans decades: drawn and fitted on a log scale; a signed one on a symmetric log
     #: scale (asinh of the value over a quarter of the typical magnitude).
@@ -106,6 +107,8 @@ class ParamInfo:
     #: stiffness): held at ``default`` in every candidate's refit, fitted only for the
     #: candidate that fits the training cycles best (``sim.identify.refitting.refine_form``).
     form: bool = False
+    #: Its index in the parameter row: given by the registry (``sim.physics.layout``).
+    column: int = -1
 
     @property
     def fit_low(self) -> float:
@@ -149,7 +152,8 @@ class EffectInfo:
     kind: Literal["physical", "measurement"]
     summary: str
     shows: str
-    flag_column: int
+    #: Its name in the kernel (``R_<symbol>_ON`` its flag, ``sim.physics.layout``).
+    symbol: str
     params: tuple[ParamInfo, ...]
     #: Its states (string modes, bristles) are invisible to the gauges: a segment of a
     #: multiple-shooting run starts from the previous segment's, not from measurements.
@@ -163,7 +167,7 @@ class EffectInfo:
     #: An effect added outside the kernel: a compiled force on the weight, N (up the
     #: incline), ``weight_force(u, v, tension, params)`` with params the tuple of its
     #: parameter values in order; the model composes a kernel with it
-    #: (``sim.effects._compose``). None for the nine of STAND.md §5, whose terms the
+    #: (``sim.physics.compose``). None for the nine of STAND.md §5, whose terms the
     #: kernel holds.
     weight_force: Any = None
     #: How its form can be generalised: the remainder signature variants (kind, channel:
@@ -171,6 +175,9 @@ class EffectInfo:
     #: effect on top of this one is named only if it beats them (a second effect must not
     #: be this one's form mismatch).
     richer: tuple[tuple[str, str], ...] = ()
+    #: Its flag's index in the parameter row (its parameters follow): given by the
+    #: registry from its place in the registry's order (``sim.physics.layout``).
+    flag_column: int = -1
 
     def param(self, name: str) -> ParamInfo:
         """A parameter by name (EffectError if unknown)."""
@@ -209,11 +216,11 @@ class EffectInfo:
 
 # fmt: off
 def param(name: str, unit: str, default: float, plausible: tuple[float, float],
-          admissible: tuple[float, float], column: int, description: str, *,
+          admissible: tuple[float, float], symbol: str, description: str, *,
           fit: bool = True, log: bool = False, drawn: bool | None = None,
           bounds: tuple[float, float] = (0.0, 0.0), why: str = "",
           scan: tuple[float, ...] = (), integer: bool = False, form: bool = False) -> ParamInfo:
     """A ParamInfo from the typical (``plausible``) and admissible ranges as pairs."""
-    return ParamInfo(name, unit, default, *plausible, *admissible, description, column, fit, log,
+    return ParamInfo(name, unit, default, *plausible, *admissible, description, symbol, fit, log,
                      drawn, bounds, why, scan, integer, form)
 # fmt: on

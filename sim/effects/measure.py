@@ -9,8 +9,9 @@
 
 The order is the physical one: the gauge filters, then the recorder samples (skew).
 Each function works on a whole run or block by block with carried state, with identical
-arithmetic either way (``sim.effects.simulator.AugmentedStream`` relies on that).
-The numba code here is self-contained (see ``sim.effects.kernel`` on numba's cache).
+arithmetic either way (``sim.physics.runs.Stream`` relies on that).
+The numba code here is self-contained (see ``sim/physics/kernel.py`` on numba's cache);
+the row's columns are read in plain Python (``measurement_rows``), never in it.
 """
 
 from __future__ import annotations
@@ -21,7 +22,7 @@ import numpy as np
 from numba import njit
 from numpy.typing import NDArray
 
-from sim.effects.kernel import (
+from sim.physics.layout import (
     R_CS_DISP,
     R_CS_FORCE,
     R_CS_ON,

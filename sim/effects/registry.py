@@ -12,21 +12,10 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
-from sim.effects import (
-    channel_time_skew,
-    dial_gauge_calibration,
-    fibre_pulley_jump,
-    fibre_transverse_vibration,
-    fibre_viscoelastic,
-    force_gauge_dynamics,
-    pulley_inertia_friction,
-    side_load_friction,
-    stick_slip_friction,
-)
-from sim.effects import kernel as ek
 from sim.effects.info import EffectError, EffectInfo, ParamInfo
+from sim.physics import layout
 
 __all__ = [
     "EFFECTS",
@@ -72,21 +61,9 @@ class EffectSpec:
         return f"{self.name}:{args}" if args else self.name
 
 
-#: The effects by name: the nine of STAND.md §5, in its order, then any ``register``ed.
-EFFECTS: dict[str, EffectInfo] = {
-    module.INFO.name: module.INFO
-    for module in (
-        fibre_viscoelastic,
-        fibre_transverse_vibration,
-        fibre_pulley_jump,
-        pulley_inertia_friction,
-        stick_slip_friction,
-        side_load_friction,
-        dial_gauge_calibration,
-        channel_time_skew,
-        force_gauge_dynamics,
-    )
-}
+#: The effects by name: the nine of STAND.md §5, in its order (``sim.effects.builtin``)
+#: with their row columns, then any ``register``ed.
+EFFECTS: dict[str, EffectInfo] = {info.name: info for info in layout.PLACED}
 
 
 def effect_info(name: str) -> EffectInfo:
@@ -143,7 +120,7 @@ def register(info: EffectInfo) -> EffectInfo:
     The effect brings a compiled ``weight_force`` (see ``EffectInfo``); its flag and
     parameters get the next free columns of the kernel row's extension block (the
     columns ``info`` gives are ignored), and a model with it switched on runs a kernel
-    composed with its force (``sim.effects._compose``). Returns the registered info, as
+    composed with its force (``sim.physics.compose``). Returns the registered info, as
     ``EFFECTS`` now holds it; ``unregister`` removes it again.
     """
     if info.name in EFFECTS:
@@ -151,13 +128,12 @@ def register(info: EffectInfo) -> EffectInfo:
     if info.weight_force is None or not hasattr(info.weight_force, "py_func"):
         raise EffectError(f"{info.name}: an added effect needs a compiled (njit) weight_force")
     used = [c for e in EFFECTS.values() if e.weight_force is not None for c in _columns(e)]
-    first = max(used, default=ek.R_X - 1) + 1
-    if first + len(info.params) >= ek.R_X + ek.N_X:
+    first = max(used, default=layout.R_X - 1) + 1
+    if first + len(info.params) >= layout.R_X + layout.N_X:
         raise EffectError(
-            f"{info.name}: no room in the kernel row ({ek.N_X} columns for added effects)"
+            f"{info.name}: no room in the kernel row ({layout.N_X} columns for added effects)"
         )
-    params = tuple(replace(p, column=first + 1 + i) for i, p in enumerate(info.params))
-    registered = replace(info, flag_column=first, params=params)
+    (registered,), _ = layout.place((info,), first)
     EFFECTS[info.name] = registered
     return registered
 

@@ -115,13 +115,13 @@ def test_string_modes_ring_at_the_predicted_tension_dependent_frequency(
     stand: StandConfig, mass: float
 ) -> None:
     # Free vibration about rest (weakly damped, drive held): the kernel's own state is set.
-    from sim._baseline import friction_arrays
-    from sim.effects import kernel
-    from sim.effects._augmented import augmented_row
+    from sim.physics import compose
+    from sim.physics.runs import friction_arrays, parameter_row
 
     p = stand.stand_params("starting", mass)
     spec = EffectSpec("fibre_transverse_vibration", {"damping_ratio": 1e-4})
-    c = kernel.pack(augmented_row(p, [spec]), *friction_arrays(p.friction))
+    kernel = compose.union()
+    c = kernel.pack(parameter_row(p, [spec]), *friction_arrays(p.friction))
     state = np.array(kernel.rest_state(c))
     state[kernel.Y_A2] += 2e-3  # pluck the weight span by 2 mm
     n = 8000

@@ -1,4 +1,4 @@
-"""The augmented simulator: equal to the baseline with effects off, consistent across its
+"""The model with effects: equal to the baseline with effects off, consistent across its
 entry points (single, batch, stream), accurate, and at rest when nothing moves."""
 
 from __future__ import annotations
@@ -9,12 +9,11 @@ import numpy as np
 import pytest
 
 from drivers.signals import Shape, SignalSpec
-from sim._baseline import friction_arrays
 from sim.config import StandConfig
 from sim.effects import EFFECTS, EffectError, EffectSpec
-from sim.effects import kernel as ek
-from sim.effects._augmented import AugmentedStream, augmented_row, simulate_augmented
 from sim.model import Model
+from sim.physics import compose, layout
+from sim.physics.runs import Stream, friction_arrays, parameter_row
 from sim.situations import SITUATIONS
 from tests.effects.helpers import RATE, signal_drive, situation_drive
 
@@ -43,12 +42,18 @@ def test_all_effects_off_reproduces_the_baseline(
 ) -> None:
     x, mass = situation_drive(stand, name)
     p = stand.stand_params(params, mass)
-    base = Model(p).run(x, RATE)  # the front door runs the baseline's own kernel
-    run = simulate_augmented(x, RATE, p)  # the augmented kernel, every effect off
-    assert _rel(run.u_m, base.u_m) <= 1e-9
-    assert _rel(run.v_m_s, base.v_m_s) <= 1e-9
-    assert _rel(run.force_n, base.force_n) <= 1e-9
-    assert run.max_substeps == 1
+    base = Model(p).run(x, RATE)  # the model composed without terms
+    n = x.size
+    u, v, t1, t2 = (np.empty(n) for _ in range(4))
+    most = compose.union().simulate_into(  # every term in, every effect off
+        x - x[0], 1.0 / RATE, 1, parameter_row(p), *friction_arrays(p.friction), u, v, t1, t2
+    )
+    # Bit for bit: an effect switched off adds exact zeros, a term left out adds nothing.
+    assert np.array_equal(u, base.u_m)
+    assert np.array_equal(v, base.v_m_s)
+    assert np.array_equal(t1, base.force_n)
+    assert np.array_equal(t2, base.force_n)
+    assert most == base.max_substeps == 1
 
 
 @pytest.mark.parametrize("name", ["3", "11", "12a"])
@@ -174,7 +179,7 @@ def test_the_simulated_stand_switches_effects_on_by_name(stand: StandConfig) -> 
     assert set(EFFECTS) <= set(available_effects())
     p = stand.stand_params("final")
     model = build_stand_model(p, RATE, ["fibre_viscoelastic", "channel_time_skew"])
-    assert isinstance(model, AugmentedStream)
+    assert isinstance(model, Stream)
     assert [e.name for e in model.effects] == ["fibre_viscoelastic", "channel_time_skew"]
     x, _ = situation_drive(stand, "10")
     _, f = model.advance(x[1:] - x[0])
@@ -187,7 +192,7 @@ def test_the_simulated_stand_takes_effect_parameters(stand: StandConfig) -> None
 
     p = stand.stand_params("final")
     model = build_stand_model(p, RATE, ["force_gauge_dynamics:cutoff_hz=40,damping_ratio=0.9"])
-    assert isinstance(model, AugmentedStream)
+    assert isinstance(model, Stream)
     (spec,) = model.effects
     assert spec.resolved() == {"cutoff_hz": 40.0, "damping_ratio": 0.9}
     with pytest.raises(EffectError, match="unknown parameter 'cutoff'"):
@@ -203,7 +208,7 @@ def test_the_exponential_step_is_exact_for_a_forced_linear_decay(rate_h: float) 
     # RK4's own step, exact for a constant rate.
     h, b, y0 = 1e-4, 3.0, -0.7
     lam = rate_h / h
-    e2, half, e, b1, b2, b4 = ek._etd_weights(lam, h)
+    e2, half, e, b1, b2, b4 = compose.union()._etd_weights(lam, h)
     n1 = b  # N = ẏ + λy = b at every stage
     ya = e2 * y0 + half * n1
     yc = e2 * ya + half * (2.0 * b - n1)
@@ -243,15 +248,15 @@ def test_stiff_decays_take_few_substeps_and_stay_accurate(
     p = stand.stand_params("final", mass)
     p = dataclasses.replace(p, damping_n_s_m=p.damping_n_s_m * damping)
     run = Model(p, [effect]).run(x, RATE)
-    fine = Model(p, [effect], substeps=ek.NSUB_MAX).run(x, RATE)
+    fine = Model(p, [effect], substeps=compose.union().NSUB_MAX).run(x, RATE)
     assert np.abs(run.force_n - fine.force_n).max() < 0.03
     assert np.abs(run.u_m - fine.u_m).max() < 1e-6
-    c = ek.pack(augmented_row(p, [effect]), *friction_arrays(p.friction))
+    c = compose.union().pack(parameter_row(p, [effect]), *friction_arrays(p.friction))
     if effect.name == "pulley_inertia_friction":
-        decay = c[ek.E_RIM]
+        decay = c[layout.E_RIM]
     else:  # the bristle's relaxation at the run's top speed
         speed = float(np.abs(run.v_m_s).max())
-        decay = c[ek.D_SIG0] * speed / (c[ek.P_FRICTION_N] * ek._mu(speed, c))
+        decay = c[layout.D_SIG0] * speed / (c[layout.P_FRICTION_N] * compose.union()._mu(speed, c))
     assert run.max_substeps <= 0.5 * np.ceil(decay / RATE / 1.5)
 
 
@@ -267,10 +272,12 @@ def test_a_stiff_bristle_steps_by_how_fast_its_rate_changes_not_by_its_size(
     effect = EffectSpec("stick_slip_friction", {"bristle_stiffness_n_m": 1e6})
     x = signal_drive(stand, SignalSpec(Shape.TRAPEZOIDAL, 0.025, 2.0, cycles=3, ramp_fraction=0.4))
     run = Model(p, [effect]).run(x, RATE)
-    fine = Model(p, [effect], substeps=ek.NSUB_MAX).run(x, RATE)
+    fine = Model(p, [effect], substeps=compose.union().NSUB_MAX).run(x, RATE)
     assert np.abs(run.force_n - fine.force_n).max() < 0.03
     assert np.abs(run.u_m - fine.u_m).max() < 1e-6
-    c = ek.pack(augmented_row(p, [effect]), *friction_arrays(p.friction))
+    c = compose.union().pack(parameter_row(p, [effect]), *friction_arrays(p.friction))
     speed = float(np.abs(run.v_m_s).max()) + 0.05
-    quarter = c[ek.D_SIG0] * speed / (c[ek.P_FRICTION_N] * ek._mu(speed, c)) / 4.0
+    quarter = (
+        c[layout.D_SIG0] * speed / (c[layout.P_FRICTION_N] * compose.union()._mu(speed, c)) / 4.0
+    )
     assert run.max_substeps <= 0.5 * np.ceil(quarter / RATE / 1.5)

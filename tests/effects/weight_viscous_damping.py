@@ -24,9 +24,9 @@ INFO = EffectInfo(
     "weight_viscous_damping", "physical",
     "a force −b·v on the weight against its velocity (oil film, eddy-current brake)",
     "force grows with the weight's speed in every test; rest and slow motion unaffected",
-    -1,  # the registry gives the flag and parameter columns
+    "VD",  # its symbol; the registry gives the flag and parameter columns
     (
-        param("damping_n_s_m", "N·s/m", 20.0, (5.0, 50.0), (0.0, 1000.0), -1,
+        param("damping_n_s_m", "N·s/m", 20.0, (5.0, 50.0), (0.0, 1000.0), "B",
               "b, damping coefficient of the weight's motion", log=True,
               bounds=(0.1, 300.0),
               why="a viscous film of 0.1–1 Pa·s over 100 cm² and 0.1 mm gives 10–100 N·s/m"),

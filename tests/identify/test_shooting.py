@@ -8,17 +8,15 @@ import numpy as np
 import pytest
 
 from drivers.signals import Shape, SignalSpec, plan_motion
-from sim import kernel
-from sim._baseline import friction_arrays, param_vector, simulate_segment_rows
 from sim.config import StandConfig, default_config
 from sim.effects import EffectSpec
-from sim.effects import kernel as ek
-from sim.effects._augmented import augmented_row, simulate_augmented_segments
-from sim.effects._starts import start_states
 from sim.identify.fitting import Candidate, simulate_values
 from sim.identify.shooting import dial_slope, segment_trace
 from sim.identify.traces import Trace, make_trace
 from sim.model import Model
+from sim.physics import compose, layout
+from sim.physics.runs import friction_arrays, parameter_row, simulate, simulate_segments
+from sim.physics.starts import start_states
 
 QUICK = SignalSpec(Shape.TRAPEZOIDAL, 0.025, 2.0, cycles=3, ramp_fraction=0.4)
 SLOW = SignalSpec(Shape.QUASI_SINUSOIDAL, 0.060, 0.5, cycles=2)
@@ -64,47 +62,34 @@ def test_a_segment_from_the_true_state_reproduces_the_open_loop_run(stand: Stand
     rel = x - x[0]
     starts = np.array([0, 700, 1500], dtype=np.int64)
     lengths = np.array([700, 900, 600], dtype=np.int64)
-    init = np.stack([np.array([[0.0, 0.0]] + [[run.u_m[s], run.v_m_s[s]] for s in starts[1:]])])
-    row = param_vector(params)[None, :]
-    u, f = simulate_segment_rows(
-        rel, stand.sample_rate_hz, row, params.friction, starts, lengths, init
-    )
+    init = np.zeros((1, starts.size, layout.N_INIT))
+    init[0, 1:, layout.I_U] = run.u_m[starts[1:]]
+    init[0, 1:, layout.I_V] = run.v_m_s[starts[1:]]
+    init[0, :, layout.I_F] = run.force_n[starts]
+    row = parameter_row(params)[None, :]
+    u, f = simulate_segments(rel, stand.sample_rate_hz, row, params.friction, starts, lengths, init)
     for k, (s, n) in enumerate(zip(starts, lengths, strict=True)):
         np.testing.assert_allclose(u[0, k, :n], run.u_m[s : s + n], atol=1e-9)
         np.testing.assert_allclose(f[0, k, :n], run.force_n[s : s + n], atol=1e-4)
-    # The augmented kernel with every effect off restarts the same way.
-    arow = augmented_row(params)[None, :]
-    ainit = np.zeros((1, starts.size, ek.N_INIT))
-    ainit[0, :, :2] = init[0]
-    ainit[0, :, ek.I_F] = run.force_n[starts]
-    ua, fa = simulate_augmented_segments(
-        rel, stand.sample_rate_hz, arow, params.friction, starts, lengths, ainit
-    )
-    np.testing.assert_allclose(ua, u, atol=1e-9)
-    np.testing.assert_allclose(fa, f, atol=1e-6)
 
 
 def test_kernel_segment_zero_is_the_open_loop_run(stand: StandConfig) -> None:
     params = stand.stand_params("final", 8.131)
     _, x = plan_motion(QUICK, stand.drive).sample(stand.sample_rate_hz)
     rel = x - x[0]
-    knots, coef = friction_arrays(params.friction)
     n = rel.size
-    u, v, f = np.empty(n), np.empty(n), np.empty(n)
-    kernel.simulate_into(
-        rel, 1.0 / stand.sample_rate_hz, 1, param_vector(params), knots, coef, u, v, f
-    )
-    su, sf = simulate_segment_rows(
+    run = simulate(rel, stand.sample_rate_hz, params)
+    su, sf = simulate_segments(
         rel,
         stand.sample_rate_hz,
-        param_vector(params)[None, :],
+        parameter_row(params)[None, :],
         params.friction,
         np.array([0]),
         np.array([n]),
-        np.zeros((1, 1, 2)),
+        np.zeros((1, 1, layout.N_INIT)),
     )
-    np.testing.assert_array_equal(su[0, 0], u)
-    np.testing.assert_array_equal(sf[0, 0], f)
+    np.testing.assert_array_equal(su[0, 0], run.u_m)
+    np.testing.assert_array_equal(sf[0, 0], run.force_n)
 
 
 def test_state_estimation_error_is_bounded_under_noise(stand: StandConfig) -> None:
@@ -135,19 +120,19 @@ def test_restarts_take_the_displacement_on_the_dial_gauges_own_scale(
     assert slope * p.projection == pytest.approx(1 + params["gain_error"], abs=3e-4)
     tr = traces[0]
     seg = segment_trace(tr)
-    row = augmented_row(p)[None, :]
+    row = parameter_row(p)[None, :]
     x_rel = tr.x_m - tr.x_m[0]
     init = start_states(
         row, x_rel, tr.rate_hz, seg.starts, seg.u_m, seg.v_m_s, seg.force_n, slope
     ).init
     expected = seg.u_m[seg.starts] / (slope * p.projection)
-    np.testing.assert_allclose(init[0, :, ek.I_U], expected)
+    np.testing.assert_allclose(init[0, :, layout.I_U], expected)
     # Without the campaign's estimate (a lone quick trace has too few calm samples) the
     # reading is taken at face value.
     if not np.isfinite(seg.dial_slope):
         channels = (seg.starts, seg.u_m, seg.v_m_s, seg.force_n)
         init = start_states(row, x_rel, tr.rate_hz, *channels).init
-        np.testing.assert_allclose(init[0, :, ek.I_U], seg.u_m[seg.starts])
+        np.testing.assert_allclose(init[0, :, layout.I_U], seg.u_m[seg.starts])
 
 
 def test_rows_of_one_batch_get_the_start_states_each_would_get_alone(stand: StandConfig) -> None:
@@ -159,17 +144,17 @@ def test_rows_of_one_batch_get_the_start_states_each_would_get_alone(stand: Stan
     x_rel = tr.x_m - tr.x_m[0]
     skews = [{"force_skew_s": 0.004, "displacement_skew_s": -0.002}, {"force_skew_s": -0.006}]
     rows = np.stack(
-        [augmented_row(p)]
-        + [augmented_row(p, [EffectSpec("channel_time_skew", s)]) for s in skews]
-        + [augmented_row(p, [EffectSpec("fibre_viscoelastic")])]
+        [parameter_row(p)]
+        + [parameter_row(p, [EffectSpec("channel_time_skew", s)]) for s in skews]
+        + [parameter_row(p, [EffectSpec("fibre_viscoelastic")])]
     )
     args = (x_rel, tr.rate_hz, seg.starts, seg.u_m, seg.v_m_s, seg.force_n, 1.01 / p.projection)
     together = start_states(rows, *args).init
     for b, row in enumerate(rows):
         np.testing.assert_array_equal(together[b], start_states(row[None, :], *args).init[0])
     # The skewed rows start elsewhere than the plain one, and apart from each other.
-    assert not np.array_equal(together[1, :, ek.I_F], together[0, :, ek.I_F])
-    assert not np.array_equal(together[1, :, ek.I_F], together[2, :, ek.I_F])
+    assert not np.array_equal(together[1, :, layout.I_F], together[0, :, layout.I_F])
+    assert not np.array_equal(together[1, :, layout.I_F], together[2, :, layout.I_F])
 
 
 def test_the_friction_table_arrays_are_the_callers_own(stand: StandConfig) -> None:
@@ -248,15 +233,15 @@ def test_chained_segments_equal_independent_ones_without_carried_states(
     _, x = plan_motion(QUICK, stand.drive).sample(stand.sample_rate_hz)
     rel = np.ascontiguousarray(x - x[0])
     rows = np.stack(
-        [augmented_row(params, [EffectSpec("fibre_viscoelastic")]), augmented_row(params)]
+        [parameter_row(params, [EffectSpec("fibre_viscoelastic")]), parameter_row(params)]
     )
     starts = np.array([0, 650, 1400], dtype=np.int64)
     lengths = np.array([700, 800, rel.size - 1400], dtype=np.int64)
-    init = np.zeros((2, 3, ek.N_INIT))
-    init[:, :, ek.I_F] = 30.0
+    init = np.zeros((2, 3, layout.N_INIT))
+    init[:, :, layout.I_F] = 30.0
     knots, coef = friction_arrays(params.friction)
     outs = []
-    for fn in (ek.simulate_segments_into, ek.simulate_chained_into):
+    for fn in (compose.union().simulate_segments_into, compose.union().simulate_chained_into):
         u, f = np.empty((2, 3, int(lengths.max()))), np.empty((2, 3, int(lengths.max())))
         fn(
             rel, 1.0 / stand.sample_rate_hz, 1, rows, knots, coef, starts, lengths, init, u, f,
@@ -563,14 +548,14 @@ def test_a_segment_holds_the_pulley_seat_where_the_recorded_slack_put_it(
     _, x = plan_motion(SLOW, stand.drive).sample(stand.sample_rate_hz)
     rel = np.ascontiguousarray(x - x[0])
     step, at = 4e-4, 1200
-    row = augmented_row(params, [EffectSpec("fibre_pulley_jump", {"step_m": step})])[None, :]
+    row = parameter_row(params, [EffectSpec("fibre_pulley_jump", {"step_m": step})])[None, :]
     starts = np.array([0, 800], dtype=np.int64)
     lengths = np.array([800, rel.size - 800], dtype=np.int64)
-    init = np.zeros((1, 2, ek.N_INIT))
+    init = np.zeros((1, 2, layout.N_INIT))
     run = Model(params).run(x, stand.sample_rate_hz)
     assert run.force_n.min() > 0.3 * params.preload_tension_n  # never slack
-    init[0, 1, ek.I_U], init[0, 1, ek.I_V] = run.u_m[800], run.v_m_s[800]
-    init[0, 1, ek.I_F] = run.force_n[800]
+    init[0, 1, layout.I_U], init[0, 1, layout.I_V] = run.u_m[800], run.v_m_s[800]
+    init[0, 1, layout.I_F] = run.force_n[800]
     knots, coef = friction_arrays(params.friction)
     seat = np.zeros((1, rel.size))
     seat[0, at:] = step
@@ -578,7 +563,7 @@ def test_a_segment_holds_the_pulley_seat_where_the_recorded_slack_put_it(
     outs = []
     for seats in (np.zeros((1, 0)), np.zeros((1, rel.size)), seat):
         u, f = np.empty((1, 2, width)), np.empty((1, 2, width))
-        ek.simulate_segments_serial(
+        compose.union().simulate_segments_serial(
             rel, 1.0 / stand.sample_rate_hz, 1, row, knots, coef, starts, lengths, init, u, f,
             seats,
         )  # fmt: skip

@@ -2,7 +2,7 @@
 
 ``diagnose-check --truth other`` draws its recordings from here. Written from STAND.md's
 descriptions, never from the candidate models: it imports nothing of ``sim.effects``,
-``sim.model``, ``sim.kernel``, ``sim._baseline`` or ``sim.identify`` (an import-linter
+``sim.model``, ``sim.physics`` or ``sim.identify`` (an import-linter
 contract), only the stand's geometry and nominal values (``sim.params``). Its own
 integrator (``_kernel``), its own equations and ranges (``effects``), its own gauges and
 noise (``gauges``), its own drive signals and campaigns (``campaign``).

@@ -1,63 +1,115 @@
-"""The augmented simulator: the baseline plus effects (private: use ``sim.model.Model``).
+"""The model's runs: rows, one run, batches, segments, a stream (private: ``sim.model``).
 
-``simulate_augmented`` runs one stand with a list of effects, ``simulate_augmented_rows``
-kernel rows (built by ``augmented_row``), ``simulate_augmented_segments`` many short
-runs from measured states, and ``AugmentedStream`` advances block by block for the
-simulated stand. Physical effects change the dynamics (``sim.effects.kernel``);
-measurement effects then act on the outputs (``sim.effects.measure``).
+``simulate`` runs one stand with a list of effects, ``simulate_rows`` parameter rows
+(built by ``parameter_row``), ``simulate_segments`` many short runs from measured
+states, and ``Stream`` advances block by block for the simulated stand. Every run goes
+through one compiled model (``sim.physics.compose``): without physical effects the
+empty set of terms (the baseline), with them the built-in union (composed with the
+forces of effects added by ``register``); measurement effects then act on the outputs
+(``sim.effects.measure``).
 """
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Sequence
 from types import ModuleType
 
 import numpy as np
 from numpy.typing import NDArray
 
-from sim._baseline import DEFAULT_SUBSTEPS, check_input, friction_arrays, param_vector
-from sim.effects import _compose, measure
-from sim.effects import kernel as ek
+from sim.effects import measure
 from sim.effects.registry import EFFECTS, EffectError, EffectSpec, check_unique, effect_info
+from sim.errors import SimulationError
 from sim.params import FrictionTable, StandParams
+from sim.physics import compose, layout
 from sim.results import BatchResult, ModelRun
 
 FloatArray = NDArray[np.float64]
 
 __all__ = [
-    "AugmentedStream",
-    "augmented_row",
-    "simulate_augmented",
-    "simulate_augmented_rows",
-    "simulate_augmented_segments",
+    "DEFAULT_SUBSTEPS",
+    "Stream",
+    "check_input",
+    "parameter_row",
+    "simulate",
+    "simulate_rows",
+    "simulate_segments",
 ]
 
+#: RK4 steps per sample interval; 1 at 2 kHz meets the 0.1 % accuracy bound (see tests).
+DEFAULT_SUBSTEPS = 1
 
-def augmented_row(stand: StandParams, effects: Sequence[EffectSpec] = ()) -> FloatArray:
+
+def param_vector(params: StandParams) -> FloatArray:
+    """The baseline's eight parameters, the first columns of a row (``layout.P_*``)."""
+    row = np.zeros(layout.R_DRIVE_SPAN)
+    row[layout.P_MASS] = params.mass_kg
+    row[layout.P_PROJ] = params.projection
+    row[layout.P_STIFF] = params.stiffness_n_m
+    row[layout.P_DAMP] = params.damping_n_s_m
+    friction_n = params.normal_force_n * params.friction_scale if params.friction else 0.0
+    row[layout.P_FRICTION_N] = friction_n
+    row[layout.P_GRAVITY_N] = params.gravity_along_n
+    row[layout.P_PRELOAD] = params.preload_m
+    row[layout.P_VREG] = params.friction.v_reg_m_s if params.friction else 1e-3
+    return row
+
+
+def friction_arrays(table: FrictionTable | None) -> tuple[FloatArray, FloatArray]:
+    """PCHIP knots and cubic coefficients (4, segments) of μ(v) for the kernel (copies)."""
+    if table is None:
+        return np.array([0.0, 1.0]), np.zeros((4, 1))  # μ ≡ 0
+    knots, coef = _pchip_arrays(table)
+    return knots.copy(), coef.copy()
+
+
+@functools.lru_cache(maxsize=64)
+def _pchip_arrays(table: FrictionTable) -> tuple[FloatArray, FloatArray]:
+    # A fit simulates one table thousands of times (the friction scale multiplies the
+    # normal force, not μ); scipy's PCHIP set-up cost more than a short segment's run.
+    pchip = table.pchip()
+    return np.asarray(pchip.x, dtype=np.float64), np.ascontiguousarray(pchip.c, dtype=np.float64)
+
+
+def check_input(x_m: FloatArray, rate_hz: float) -> FloatArray:
+    """The drive positions relative to the first (the model starts at rest there), checked."""
+    x = np.ascontiguousarray(x_m, dtype=np.float64)
+    if x.ndim != 1 or x.shape[0] < 2:
+        raise SimulationError(f"drive position must be a 1-D series of ≥ 2 samples, got {x.shape}")
+    if not np.all(np.isfinite(x)):
+        raise SimulationError("All drive positions must be finite.")
+    if not (np.isfinite(rate_hz) and rate_hz > 0):
+        raise SimulationError(f"sample rate must be > 0 Hz, got {rate_hz}")
+    rel: FloatArray = x - x[0]
+    return rel
+
+
+def parameter_row(stand: StandParams, effects: Sequence[EffectSpec] = ()) -> FloatArray:
     """The kernel's parameter row for a stand and its effects (checked)."""
     check_unique(effects)
-    row = np.zeros(ek.N_ROW)
-    row[: ek.R_DRIVE_SPAN] = param_vector(stand)
-    row[ek.R_DRIVE_SPAN] = stand.drive_span_m
-    row[ek.R_FREE_SPAN] = stand.free_length_m
-    row[ek.R_FIBRE_LEN] = stand.fibre_length_m
-    row[ek.R_LIN_DENSITY] = stand.linear_density_kg_m
+    row = np.zeros(layout.N_ROW)
+    row[: layout.R_DRIVE_SPAN] = param_vector(stand)
+    row[layout.R_DRIVE_SPAN] = stand.drive_span_m
+    row[layout.R_FREE_SPAN] = stand.free_length_m
+    row[layout.R_FIBRE_LEN] = stand.fibre_length_m
+    row[layout.R_LIN_DENSITY] = stand.linear_density_kg_m
     sin_beta = stand.lateral_offset_m / stand.free_length_m
-    row[ek.R_SIN_BETA] = sin_beta
+    row[layout.R_SIN_BETA] = sin_beta
     # The weight span leaves the weight along the guide (up the incline, share n = cos β)
     # and sideways (sin β, horizontal): its vertical share is cos β·sin α.
     vertical = stand.projection * np.sin(np.radians(stand.incline_deg))
-    row[ek.R_G_PERP_WEIGHT_SPAN] = stand.gravity_m_s2 * np.sqrt(1.0 - vertical**2)
-    row[ek.R_GRAVITY] = stand.gravity_m_s2
-    row[ek.R_SIN_HALF_WRAP] = np.sin(np.radians(stand.wrap_angle_deg) / 2)
-    row[ek.R_RADIUS] = stand.pulley_radius_m
+    row[layout.R_G_PERP_WEIGHT_SPAN] = stand.gravity_m_s2 * np.sqrt(1.0 - vertical**2)
+    row[layout.R_GRAVITY] = stand.gravity_m_s2
+    row[layout.R_SIN_HALF_WRAP] = np.sin(np.radians(stand.wrap_angle_deg) / 2)
+    row[layout.R_RADIUS] = stand.pulley_radius_m
     for spec in effects:
         info = effect_info(spec.name)
         if info.check_stand is not None:
             info.check_stand(stand)
         row[info.flag_column] = 1.0
         if info.weight_force is not None:
-            row[ek.R_X_ON] = 1.0
+            row[layout.R_X_ON] = 1.0
         values = spec.resolved()
         for p in info.params:
             row[p.column] = values[p.name]
@@ -65,16 +117,21 @@ def augmented_row(stand: StandParams, effects: Sequence[EffectSpec] = ()) -> Flo
 
 
 def _kernel(rows: FloatArray) -> ModuleType:
-    """The kernel for these rows: composed with the added effects any of them has on."""
+    """The compiled model for these rows: the baseline unless one has a physical effect on.
+
+    With one, the union of the built-in terms, composed with the forces of the added
+    effects any row has on.
+    """
     rows2 = np.atleast_2d(rows)
-    if not np.any(rows2[:, ek.R_X_ON] > 0):
-        return ek
+    physical = [info.flag_column for info in EFFECTS.values() if info.kind == "physical"]
+    if not np.any(rows2[:, physical] > 0):
+        return compose.baseline()
     added = tuple(
         info
         for info in EFFECTS.values()
         if info.weight_force is not None and np.any(rows2[:, info.flag_column] > 0)
     )
-    return _compose.kernel_for(added)
+    return compose.kernel_for(layout.TERMS, added)
 
 
 def _measure_run(
@@ -90,7 +147,7 @@ def _settled(runs: int) -> FloatArray:
     return np.full((runs, 2), np.nan)
 
 
-def simulate_augmented(
+def simulate(
     x_m: FloatArray,
     rate_hz: float,
     stand: StandParams,
@@ -114,7 +171,7 @@ def simulate_augmented(
     """
     x = check_input(x_m, rate_hz)
     n = x.shape[0]
-    row = augmented_row(stand, effects)
+    row = parameter_row(stand, effects)
     knots, coef = friction_arrays(stand.friction)
     u, v, t1, t2 = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
     most = _kernel(row).simulate_into(x, 1.0 / rate_hz, substeps, row, knots, coef, u, v, t1, t2)
@@ -125,14 +182,14 @@ def simulate_augmented(
     return ModelRun(t, x_out, rec_u, v, rec_f, t0, u, t1, t2, int(most))
 
 
-def simulate_augmented_rows(
+def simulate_rows(
     x_rel_m: FloatArray,
     rate_hz: float,
     rows: FloatArray,
     table: FrictionTable | None,
     substeps: int = DEFAULT_SUBSTEPS,
 ) -> BatchResult:
-    """Lowest-level batch entry: kernel rows (``augmented_row``), drive relative to rest.
+    """Lowest-level batch entry: kernel rows (``parameter_row``), drive relative to rest.
 
     ``x_rel_m`` is (N,) shared by all rows or (rows, N); all rows share one friction table.
     """
@@ -141,28 +198,27 @@ def simulate_augmented_rows(
     sets, n = rows2.shape[0], x2.shape[1]
     if x2.shape[0] not in (1, sets):
         raise EffectError(f"drive rows ({x2.shape[0]}) must be 1 or one per set ({sets})")
-    u, v = np.empty((sets, n)), np.empty((sets, n))
-    t1, t2 = np.empty((sets, n)), np.empty((sets, n))
+    kernel = _kernel(rows2)
+    u, v, t1 = np.empty((sets, n)), np.empty((sets, n)), np.empty((sets, n))
+    # With one segment the weight side's tension is the drive side's: the runner writes
+    # the same value twice into one array (256 sets of a 60 s run: 250 MB less to touch,
+    # 9 % of the batch's time).
+    t2 = t1 if kernel.SEGMENTS < 2 else np.empty((sets, n))
     knots, coef = friction_arrays(table)
     dt = 1.0 / rate_hz
-    _kernel(rows2).simulate_batch_into(x2, dt, substeps, rows2, knots, coef, u, v, t1, t2)
+    kernel.simulate_batch_into(x2, dt, substeps, rows2, knots, coef, u, v, t1, t2)
+    t = np.arange(n) / rate_hz
+    mrows = measure.measurement_rows(rows2)
+    if not _gauged(mrows):
+        return BatchResult(t, u, v, t1, u, t1)  # no gauge effect: recorded = true
     rec_u, rec_f = np.empty_like(u), np.empty_like(t1)
-    measure.measure_batch_into(
-        u, t1, dt, measure.measurement_rows(rows2), _settled(sets), rec_u, rec_f
-    )
-    return BatchResult(np.arange(n) / rate_hz, rec_u, v, rec_f, u, t1)
+    measure.measure_batch_into(u, t1, dt, mrows, _settled(sets), rec_u, rec_f)
+    return BatchResult(t, rec_u, v, rec_f, u, t1)
 
 
-def measure_outputs(
-    u: FloatArray, force: FloatArray, rate_hz: float, rows: FloatArray
-) -> tuple[FloatArray, FloatArray]:
-    """Recorded u (m), F (N) of whole runs (sets, samples): the rows' gauge effects."""
-    out_u, out_f = np.empty_like(u), np.empty_like(force)
-    measure.measure_batch_into(
-        np.ascontiguousarray(u), np.ascontiguousarray(force), 1.0 / rate_hz,
-        measure.measurement_rows(rows), _settled(u.shape[0]), out_u, out_f,
-    )  # fmt: skip
-    return out_u, out_f
+def _gauged(mrows: FloatArray) -> bool:
+    """Whether any measurement row has a gauge effect on (else the channels are the true)."""
+    return bool(mrows[:, [measure.M_DG_ON, measure.M_FG_ON, measure.M_CS_ON]].any())
 
 
 def measure_segments(
@@ -183,10 +239,10 @@ def measure_segments(
     """
     sets, segs, width = u.shape
     mrows = measure.measurement_rows(rows)
-    if not mrows[:, [measure.M_DG_ON, measure.M_FG_ON, measure.M_CS_ON]].any():
+    if not _gauged(mrows):
         return u, force  # no gauge effect: the recorded channels are the true ones
     m = np.repeat(mrows, segs, axis=0)
-    gauge0 = np.ascontiguousarray(init[:, :, [ek.I_F, ek.I_FRATE]], dtype=np.float64)
+    gauge0 = np.ascontiguousarray(init[:, :, [layout.I_F, layout.I_FRATE]], dtype=np.float64)
     gauge0[:, starts == 0, :] = np.nan
     flat_u = np.ascontiguousarray(u.reshape(sets * segs, width))
     flat_f = np.ascontiguousarray(force.reshape(sets * segs, width))
@@ -197,7 +253,7 @@ def measure_segments(
     return rec_u.reshape(u.shape), rec_f.reshape(force.shape)
 
 
-def simulate_augmented_segments(
+def simulate_segments(
     x_rel_m: FloatArray,
     rate_hz: float,
     rows: FloatArray,
@@ -212,8 +268,8 @@ def simulate_augmented_segments(
 ) -> tuple[FloatArray, FloatArray]:
     """Multiple shooting: many short runs of many rows from measured states, in parallel.
 
-    ``init`` (sets, segments, ``ek.N_INIT``) holds each segment's measured start (u m,
-    v m/s, F N, high-passed elongation m; see ``ek.measured_state`` for how the effects'
+    ``init`` (sets, segments, ``layout.N_INIT``) holds each segment's measured start (u m,
+    v m/s, F N, high-passed elongation m; see the kernel's ``measured_state`` for how the effects'
     own states are set from it); a segment starting at sample 0 starts from static rest;
     string modes, bristles and the pulley seat carry over from the previous segment's
     run when ``chained``. Returns the *recorded* u (m) and F (N), shape (sets, segments,
@@ -221,7 +277,7 @@ def simulate_augmented_segments(
     held past its end. ``serial``: on the calling thread, without the GIL (several
     traces side by side) instead of on all cores. ``seats`` (sets, samples): the pulley
     seat's offset each row's runs hold at every sample, as the recorded slack episodes
-    put it (``_starts.start_states``); None: the model's own slack moves it.
+    put it (``starts.start_states``); None: the model's own slack moves it.
     """
     rows2 = np.ascontiguousarray(np.atleast_2d(rows), dtype=np.float64)
     sets, segs, width = rows2.shape[0], starts.shape[0], int(lengths.max())
@@ -244,12 +300,12 @@ def simulate_augmented_segments(
     return measure_segments(u, t1, rate_hz, rows2, starts, init)
 
 
-class AugmentedStream:
-    """The augmented model advanced block by block (for the simulated stand).
+class Stream:
+    """The model advanced block by block (for the simulated stand).
 
     Starts at static rest with the drive at ``x0_m``; each ``advance`` takes the drive
     positions of the next samples and returns the *recorded* u (m) and F (N) at them,
-    equal to one ``simulate_augmented`` call over the concatenated blocks. A stream
+    equal to one ``simulate`` call over the concatenated blocks. A stream
     cannot look ahead, so a negative channel skew (a channel recorded early) is refused.
     """
 
@@ -266,7 +322,7 @@ class AugmentedStream:
         self.stand = stand
         self.rate_hz = rate_hz
         self.effects = tuple(effects)
-        self._row = augmented_row(stand, effects)
+        self._row = parameter_row(stand, effects)
         self._m = measure.measurement_rows(self._row)[0]
         self._skews = (self._m[measure.M_SKEW_U], self._m[measure.M_SKEW_F])
         if self._m[measure.M_CS_ON] > 0 and min(self._skews) < 0:
@@ -278,7 +334,7 @@ class AugmentedStream:
         self._substeps = substeps
         self._x0 = x0_m
         self._last_x = x0_m
-        t0 = self._c[ek.D_K1] * self._c[ek.D_D10]  # the force at sample 0, as simulate_into
+        t0 = self._c[layout.D_K1] * self._c[layout.D_D10]  # the force at sample 0, as simulate_into
         self._gauge = np.array([t0, 0.0, t0])  # filter state (y, ẏ, previous input)
         u_rest = self._m[measure.M_OFFSET] if self._m[measure.M_DG_ON] > 0 else 0.0
         depth = int(np.ceil(max(self._skews) * rate_hz)) + 2
@@ -288,7 +344,7 @@ class AugmentedStream:
     @property
     def velocity_m_s(self) -> float:
         """Weight velocity after the last sample, m/s."""
-        return float(self._y[ek.Y_V])
+        return float(self._y[1])  # v: the second state in every set
 
     def advance(self, x_block_m: FloatArray) -> tuple[FloatArray, FloatArray]:
         """Recorded weight displacement u (m) and force F (N) at the next samples."""

@@ -18,10 +18,10 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import NDArray
 
-from sim.effects import kernel as ek
 from sim.effects.fibre_pulley_jump import recorded_seat
 from sim.effects.info import EffectInfo, Measured
 from sim.effects.registry import EFFECTS
+from sim.physics import layout
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -32,7 +32,7 @@ __all__ = ["StartStates", "start_states"]
 class StartStates(NamedTuple):
     """What the segment runs of a batch start from."""
 
-    #: (sets, segments, ek.N_INIT): each segment's measured start (columns ek.I_*).
+    #: (sets, segments, layout.N_INIT): each segment's measured start (columns layout.I_*).
     init: FloatArray
     #: (sets, samples): each row's pulley-seat offset at every sample, as the recorded
     #: slack episodes put it (``fibre_pulley_jump.recorded_seat``; 0 where the row has no
@@ -56,8 +56,8 @@ def start_states(
     ``dial_slope``: du_rec/dx at constant force (NaN: take the gauge's scale as 1).
     """
     rows2 = np.atleast_2d(rows)
-    init = np.zeros((rows2.shape[0], starts.size, ek.N_INIT))
-    jumps = rows2[:, ek.R_PJ_ON] > 0
+    init = np.zeros((rows2.shape[0], starts.size, layout.N_INIT))
+    jumps = rows2[:, layout.R_PJ_ON] > 0
     seats = np.zeros((rows2.shape[0], x_rel_m.size if np.any(jumps) else 0))
     # Rows whose channel transforms agree share their true channels (every row of a fit
     # but a skew's): computed once per batch, not once per row over the whole trace.
@@ -69,10 +69,10 @@ def start_states(
             u, v, force = _true_channels(row, on, rate_hz, u_m, v_m_s, force_n, dial_slope)
             channels[key] = (u, v, force, np.gradient(force, 1.0 / rate_hz)[starts])
         u, v, force, rate = channels[key]
-        init[b, :, ek.I_U] = u[starts]
-        init[b, :, ek.I_V] = v[starts]
-        init[b, :, ek.I_F] = force[starts]
-        init[b, :, ek.I_FRATE] = rate
+        init[b, :, layout.I_U] = u[starts]
+        init[b, :, layout.I_V] = v[starts]
+        init[b, :, layout.I_F] = force[starts]
+        init[b, :, layout.I_FRATE] = rate
         measured = Measured(x_rel_m, rate_hz, u_m, u, v, force)
         for info in on:
             if info.start_state is not None:
@@ -87,7 +87,7 @@ def _transform_key(row: FloatArray, on: list[EffectInfo]) -> bytes:
 
     The gauge's scale and, for each effect with an inverse, its flag and parameters.
     """
-    parts = [row[ek.P_PROJ]]
+    parts = [row[layout.P_PROJ]]
     for info in on:
         if info.true_channels is not None:
             parts += [float(info.flag_column)] + [row[p.column] for p in info.params]
@@ -109,6 +109,6 @@ def _true_channels(
         if info.true_channels is not None:
             u, v, force = info.true_channels(row, rate_hz, u, v, force)
     if np.isfinite(dial_slope) and dial_slope > 0:
-        scale = dial_slope * row[ek.P_PROJ]
+        scale = dial_slope * row[layout.P_PROJ]
         u, v = u / scale, v / scale
     return u, v, force

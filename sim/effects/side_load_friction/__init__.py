@@ -1,11 +1,10 @@
 """Extra guide friction from the fibre's lateral pull on the weight.
 
-Terms: ``sim.effects.kernel`` (why there: docs/architecture.md); equations: docs/effects.md.
+Terms: ``sim.physics.kernel`` (why there: docs/architecture.md); equations: docs/effects.md.
 """
 
 from __future__ import annotations
 
-from sim.effects import kernel as ek
 from sim.effects.info import EffectInfo, param
 
 # The same declarative shape in every effect module (what it means: sim/effects/info.py).
@@ -15,9 +14,9 @@ INFO = EffectInfo(
     "the lateral pull T·sin β presses the weight on the guide wall: extra friction "
     "μ_s·T·sin β (T the weight-side tension), zero while slack",
     "friction that grows with tension and vanishes when slack",
-    ek.R_SL_ON,
+    "SL",
     (
-        param("friction_coeff", "1", 0.1, (0.03, 0.3), (0.0, 2.0), ek.R_SL_MU,
+        param("friction_coeff", "1", 0.1, (0.03, 0.3), (0.0, 2.0), "MU",
               "μ_s, friction coefficient of the guide wall", bounds=(0.0, 0.8),
               why="steel or aluminium on a dry guide wall: up to 0.6–0.8"),
     ),
