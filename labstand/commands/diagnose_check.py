@@ -22,6 +22,7 @@ from labstand.distributed import (
 )
 from labstand.errors import CommandError, ExitCode
 from labstand.targets import FILE, FOLDER
+from sim.checks.choices import MASSES_KG, RECORDING_SETS, TRUTHS
 
 if TYPE_CHECKING:  # imported where they run: `diagnose-check --help` loads no numba
     from drivers.signals import SignalSpec
@@ -30,13 +31,6 @@ if TYPE_CHECKING:  # imported where they run: `diagnose-check --help` loads no n
     from sim.checks.otherstand.campaign import OtherRecording
     from sim.config import StandConfig
 
-# Literal copies of sim.checks.check's TRUTHS and MASSES_KG, which imports numba: the
-# parser is built without it (tests/core/test_cli_startup.py checks that they agree).
-TRUTHS = ("same", "other", "outside")
-#: The check's recording sets (``sim.checks.check.RECORDING_SETS``, not imported here:
-#: ``--help`` loads no numba).
-RECORDING_SETS = ("moderate", "gentle", "brisk", "paper")
-MASSES_KG = (3.096, 8.131)
 
 LABEL = "labstand diagnose-check"
 _WORDS = {2: "two", 3: "three"}

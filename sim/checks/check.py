@@ -31,6 +31,7 @@ import numpy as np
 
 from drivers.signals import Shape, SignalSpec, plan_motion
 from sim.checks.check_other import PairCase, named_effects, other_campaign_traces, pairs_summary
+from sim.checks.choices import MASSES_KG, RECORDING_SETS, TRUTHS
 from sim.checks.otherstand.campaign import OTHER_FULL, OTHER_SETS, OtherRecording
 from sim.checks.otherstand.outside import OUTSIDE_EFFECTS, SIGNATURE_KIND
 from sim.config import StandConfig
@@ -49,14 +50,10 @@ from sim.params import StandParams
 log = logging.getLogger(__name__)
 
 CLASSES = ["none", *EFFECTS]
-#: Where a check's truth comes from: the candidates' own code, the other stand, or the
-#: other stand with effects outside the catalogue (``sim.checks.otherstand.outside``).
-TRUTHS = ("same", "other", "outside")
 #: A ``none`` campaign whose recorder adds artefacts (``Realism.with_artefacts``).
 ARTEFACTS = "artefacts"
 #: The outside truth's classes: none, none with artefacts, and the five outside effects.
 OUTSIDE_CLASSES = ["none", ARTEFACTS, *OUTSIDE_EFFECTS]
-MASSES_KG = (3.096, 8.131)
 #: Drive encoder noise on x, m rms (the model is driven by the *measured* x).
 DRIVE_NOISE_M = 1e-6
 
@@ -79,10 +76,6 @@ SMALL_CAMPAIGN = (
 #: A campaign's recordings: (name, signal) under the stand's drive limits, or the other
 #: stand's recordings (signal and limits each; ``sim.checks.otherstand.campaign.OTHER_SETS``).
 CampaignSpec = Sequence[tuple[str, SignalSpec] | OtherRecording]
-#: The recording sets a check can draw its campaigns with (``recording_set``): the other
-#: stand's (the validation campaigns' four drive signals are ``moderate``), and the
-#: paper-like quick, medium and slow recordings the first checks used.
-RECORDING_SETS = ("moderate", "gentle", "brisk", "paper")
 
 
 def recording_set(name: str, stand: StandConfig) -> tuple[OtherRecording, ...]:

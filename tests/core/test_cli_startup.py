@@ -90,14 +90,6 @@ def test_a_mistyped_command_is_refused_in_one_line(capsys: pytest.CaptureFixture
     assert err.count("\n") == 1 and "invalid choice: 'simulat'" in err and "diagnose" in err
 
 
-def test_literal_copies_for_the_parser_agree_with_their_sources() -> None:
-    from labstand.commands import diagnose_check
-    from sim.checks.check import MASSES_KG, RECORDING_SETS, TRUTHS
-
-    assert diagnose_check.TRUTHS == TRUTHS and diagnose_check.MASSES_KG == MASSES_KG
-    assert diagnose_check.RECORDING_SETS == RECORDING_SETS
-
-
 def test_diagnose_check_refuses_an_unknown_class_before_running(
     capsys: pytest.CaptureFixture[str],
 ) -> None:
