@@ -53,5 +53,6 @@ INFO = EffectInfo(
     true_channels=_true_channels,
     # Richer forms: a delay that depends on frequency: a filter on the force reading.
     richer=(("resonance", "F"),),
+    leads=("force_skew_s", "displacement_skew_s"),
 )
 # fmt: on

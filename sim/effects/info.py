@@ -175,6 +175,16 @@ class EffectInfo:
     #: effect on top of this one is named only if it beats them (a second effect must not
     #: be this one's form mismatch).
     richer: tuple[tuple[str, str], ...] = ()
+    #: Start points for its refit that the recordings or the fit show directly:
+    #: ``"module:function"``, ``function(traces, nominal, values) -> [values, ...]``,
+    #: imported by the diagnosis where it refits this effect (the function reads
+    #: ``sim.identify``'s traces, which this metadata must not import). None: none.
+    data_starts: str | None = None
+    #: Whether those starts are read again with a refit's own baseline (``read_again``).
+    read_again: bool = False
+    #: Parameters (s) whose negative value records a channel ahead of the model: a
+    #: segment run then starts that much earlier (``fitting.simulate_values``).
+    leads: tuple[str, ...] = ()
     #: Its flag's index in the parameter row (its parameters follow): given by the
     #: registry from its place in the registry's order (``sim.physics.layout``).
     flag_column: int = -1

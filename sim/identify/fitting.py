@@ -36,8 +36,6 @@ from sim.params import StandParams
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
 log = logging.getLogger(__name__)
-#: The effect whose channels may be recorded early (read ahead of the simulated run).
-SKEW = "channel_time_skew"
 
 #: Baseline multipliers: (name, low, high, log scale).
 BASELINE_PARAMS = (
@@ -215,9 +213,9 @@ class FitResult:
 
 
 def _early_s(values: dict[str, float]) -> float:
-    """How far ahead of its time a channel is recorded (a negative skew), s; 0 if none."""
-    prefix = f"{SKEW}."
-    return max([0.0] + [-v for k, v in values.items() if k.startswith(prefix)])
+    """How far ahead of its time a channel is recorded (``EffectInfo.leads``), s; 0 if none."""
+    leads = {f"{info.name}.{p}" for info in EFFECTS.values() for p in info.leads}
+    return max([0.0] + [-v for k, v in values.items() if k in leads])
 
 
 def simulate_values(

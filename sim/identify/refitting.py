@@ -8,11 +8,12 @@ refitted and only the decision's gain matters; the accepted ones are polished
 from __future__ import annotations
 
 import dataclasses
+import importlib
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import cast
 
-from sim.identify.branch_starts import EFFECT as BRANCH_EFFECT
-from sim.identify.branch_starts import branch_starts
+from sim.effects import EFFECTS
 from sim.identify.fitting import (
     Candidate,
     FitResult,
@@ -23,8 +24,6 @@ from sim.identify.fitting import (
 )
 from sim.identify.heldout import Outputs, heldout_excess
 from sim.identify.screening import outputs_of
-from sim.identify.seat_probe import EFFECT as SEAT_EFFECT
-from sim.identify.seat_probe import seat_probes
 from sim.identify.traces import Trace
 from sim.params import StandParams
 
@@ -42,6 +41,8 @@ REFIT_FTOL = 1e-3
 POLISH_EVALUATIONS = 40
 
 Progress = Callable[[str], None]
+#: An effect's start points from the recordings or a fit (``EffectInfo.data_starts``).
+DataStarts = Callable[[Sequence[Trace], StandParams, dict[str, float]], list[dict[str, float]]]
 
 
 @dataclass
@@ -105,7 +106,10 @@ def read_again(
     ×0.80, c ×1.0. Read again and tried at those, the ratchet costs 0.09. The local fit
     from the best such start is kept if it fits the training cycles better.
     """
-    read = _READ_AGAIN.get(candidate.effect or "")
+    info = EFFECTS.get(candidate.effect or "")
+    # Not the branch's: its starts take the branch's share out of k and c, and a refit's
+    # k and c with a branch in its model hold no such share.
+    read = _starts_of(info.name) if info is not None and info.read_again else None
     starts = read(traces, nominal, res.values) if read is not None else []
     if not starts:
         return res
@@ -172,21 +176,22 @@ def closure(x_before: float, x_after: float, x_base: float) -> float:
 def data_starts(
     effect: str, traces: Sequence[Trace], nominal: StandParams, values: dict[str, float]
 ) -> list[dict[str, float]]:
-    """Start points the recordings or the fit show directly.
+    """Start points the recordings or the fit show directly (``EffectInfo.data_starts``).
 
-    The pulley seat's steps (``seat_probe``); the Maxwell branch with the share of it
-    that the fit's stiffness and damping absorbed given back (``branch_starts``).
+    E.g. the pulley seat's steps; the Maxwell branch with the share of it that the fit's
+    stiffness and damping absorbed given back.
     """
-    starts = _DATA_STARTS.get(effect)
+    starts = _starts_of(effect)
     return starts(traces, nominal, values) if starts is not None else []
 
 
-#: Each effect's start points from the recordings or the fit (``data_starts``).
-_DATA_STARTS = {SEAT_EFFECT: seat_probes, BRANCH_EFFECT: branch_starts}
-#: … and those read again with the refit's own baseline (``read_again``). Not the
-#: branch's: its starts take the branch's share out of k and c, and a refit's k and c
-#: with a branch in its model hold no such share.
-_READ_AGAIN = {SEAT_EFFECT: seat_probes}
+def _starts_of(effect: str) -> DataStarts | None:
+    """An effect's data-start function, imported from where its module names it."""
+    info = EFFECTS.get(effect)
+    if info is None or info.data_starts is None:
+        return None
+    module, _, name = info.data_starts.partition(":")
+    return cast("DataStarts", getattr(importlib.import_module(module), name))
 
 
 def own_values(effect: str, values: dict[str, float]) -> dict[str, float]:

@@ -9,7 +9,7 @@ import pytest
 
 from sim.checks.check import CaseSpec, make_campaign
 from sim.config import default_config
-from sim.identify.branch_starts import EFFECT, absorbed_share, branch_starts
+from sim.effects.fibre_viscoelastic.branch_starts import EFFECT, absorbed_share, branch_starts
 from sim.identify.fitting import Candidate, Objective, fit, grid_axis
 from sim.identify.shooting import dial_slope
 

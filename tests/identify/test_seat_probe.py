@@ -10,7 +10,7 @@ import pytest
 from drivers.signals import plan_motion
 from sim.config import StandConfig, default_config
 from sim.effects import EffectSpec
-from sim.identify.seat_probe import EFFECT, seat_probes, taut_law
+from sim.effects.fibre_pulley_jump.seat_probe import EFFECT, seat_probes, taut_law
 from sim.identify.traces import Trace, make_trace
 from sim.model import Model
 from sim.situations import SITUATIONS

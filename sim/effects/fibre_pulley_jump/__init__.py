@@ -97,5 +97,7 @@ INFO = EffectInfo(
     start_state=_start_state,
     # Richer forms: more seats, a creeping seat: a force with position, a slow u offset.
     richer=(("position", "u+F"), ("drift", "u")),
+    data_starts="sim.effects.fibre_pulley_jump.seat_probe:seat_probes",
+    read_again=True,
 )
 # fmt: on

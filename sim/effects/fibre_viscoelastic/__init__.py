@@ -63,5 +63,6 @@ INFO = EffectInfo(
     start_state=_start_state,
     # Richer forms: another relaxation branch or a nonlinear law: a filtered or curved tension.
     richer=(("strain", "u+F"), ("resonance", "u+F")),
+    data_starts="sim.effects.fibre_viscoelastic.branch_starts:branch_starts",
 )
 # fmt: on
