@@ -152,7 +152,8 @@ def run_cases(
 
 def _classes(args: argparse.Namespace) -> list[str]:
     """The classes asked for (CommandError, exit 2, for an unknown one)."""
-    from sim.checks.check import ARTEFACTS, CLASSES, OUTSIDE_CLASSES
+    from sim.checks.check import CLASSES, OUTSIDE_CLASSES
+    from sim.checks.choices import ARTEFACTS
 
     known = OUTSIDE_CLASSES if args.truth == "outside" else [*CLASSES, ARTEFACTS]
     if args.effects is None:

@@ -1,20 +1,14 @@
 """The check on withheld effects: campaigns with known truth, diagnosed blind, scored.
 
-Each campaign is generated, diagnosed without its answer, and the answer scored.
-
 For every effect and for ``none``, at each weight mass, a campaign is drawn: a "real"
 stand (stiffness, damping and friction scale off nominal by up to ±25 %), the effect at
-a random magnitude within its plausible range, realistic gauge noise, hum and
-quantisation, and noise on the drive encoder too. Its recordings are simulated with that
-truth: ``campaign``, the paper-like quick, medium and slow motions by default here, or a
-named set (``recording_set``: the CLI's default is the validation campaigns' four, for
-either truth). The diagnosis sees only the recordings (as DataFrames, like files read
-back) and the nominal stand.
-
-``truth_stand``: ``"same"`` draws the truth from the candidate models themselves (as
-above); ``"other"`` from ``sim.checks.otherstand``, an independently written stand with a second
-formulation of every effect, its own ranges, four other drive signals and the validation
-set's noise levels. ``pairs`` (other truth only) adds campaigns with two effects at once.
+a random magnitude within its plausible range, realistic gauge and drive encoder noise.
+Its recordings (``campaign``, or a named ``recording_set``) are simulated with that
+truth; the diagnosis sees only the recordings and the nominal stand. ``truth_stand``:
+``"same"`` draws the truth from the candidate models themselves; ``"other"`` from
+``sim.checks.otherstand``, an independently written stand with a second form of every
+effect; ``"outside"`` that stand with effects outside the catalogue. ``pairs`` and
+``triples`` add campaigns with several effects at once (scores: ``summaries``).
 """
 
 from __future__ import annotations
@@ -30,10 +24,11 @@ from typing import Any
 import numpy as np
 
 from drivers.signals import Shape, SignalSpec, plan_motion
+from sim.checks import summaries
 from sim.checks.check_other import PairCase, named_effects, other_campaign_traces, pairs_summary
-from sim.checks.choices import MASSES_KG, RECORDING_SETS, TRUTHS
+from sim.checks.choices import ARTEFACTS, MASSES_KG, RECORDING_SETS, TRUTHS
 from sim.checks.otherstand.campaign import OTHER_FULL, OTHER_SETS, OtherRecording
-from sim.checks.otherstand.outside import OUTSIDE_EFFECTS, SIGNATURE_KIND
+from sim.checks.otherstand.outside import OUTSIDE_EFFECTS
 from sim.config import StandConfig
 from sim.effects import EFFECTS, EffectSpec
 from sim.effects.realism import MeasurementNoise, NoiseSpec, draw_real_stand
@@ -50,8 +45,6 @@ from sim.params import StandParams
 log = logging.getLogger(__name__)
 
 CLASSES = ["none", *EFFECTS]
-#: A ``none`` campaign whose recorder adds artefacts (``Realism.with_artefacts``).
-ARTEFACTS = "artefacts"
 #: The outside truth's classes: none, none with artefacts, and the five outside effects.
 OUTSIDE_CLASSES = ["none", ARTEFACTS, *OUTSIDE_EFFECTS]
 #: Drive encoder noise on x, m rms (the model is driven by the *measured* x).
@@ -154,89 +147,12 @@ class CheckResult:
                 float(np.median([c.oracle_shrink for c in effects_ok])) if effects_ok else 0.0
             ),
             "median_seconds": float(np.median([c.seconds for c in self.cases])) if n else 0.0,
-            "verdicts": verdict_summary(self.cases),
-            "coverage": coverage_summary(self.cases),
-            "trends": trend_summary(self.cases),
+            "verdicts": summaries.verdict_summary(self.cases),
+            "coverage": summaries.coverage_summary(self.cases),
+            "trends": summaries.trend_summary(self.cases),
             "details": [c.__dict__ for c in self.cases],
             **({"pairs": pairs_summary(self.pair_cases)} if self.pair_cases else {}),
         }
-
-
-def verdict_summary(cases: Sequence[Case]) -> dict[str, Any]:
-    """What the verdicts say, by kind of truth (each share over its campaigns; None: none).
-
-    ``none``: none and artefact-only campaigns answered ``baseline_adequate``;
-    ``outside``: out-of-catalogue truths answered ``unexplained`` or
-    ``partly_explained``, with a catalogue effect named, with the best signature of the
-    truth's kind; ``catalogue``: single-effect truths whose named set is exactly the truth.
-    """
-
-    def share(selected: Sequence[Case], test: Callable[[Case], bool]) -> float | None:
-        return sum(map(test, selected)) / len(selected) if selected else None
-
-    nones = [c for c in cases if c.truth in ("none", ARTEFACTS)]
-    outside = [c for c in cases if c.truth in OUTSIDE_EFFECTS]
-    catalogue = [c for c in cases if c.truth in EFFECTS]
-    return {
-        "none_adequate": share(nones, lambda c: c.verdict == "baseline_adequate"),
-        "outside_flagged": share(
-            outside, lambda c: c.verdict in ("unexplained", "partly_explained")
-        ),
-        "outside_catalogue_named": share(outside, lambda c: bool(c.named)),
-        "outside_kind_right": share(
-            outside,
-            lambda c: bool(c.signature_kinds) and c.signature_kinds[0] == SIGNATURE_KIND[c.truth],
-        ),
-        "catalogue_exact": share(catalogue, lambda c: c.named == (c.truth,)),
-    }
-
-
-def coverage_summary(cases: Sequence[Case]) -> dict[str, dict[str, float]]:
-    """Per parameter (the baseline's and ``effect.param``): share of intervals holding the truth.
-
-    Counted where the truth is known and the diagnosis reported an interval for it: the
-    baseline's multipliers on same-form truths, an effect's parameters where the effect
-    was named. ``{name: {"share": s, "intervals": n}}``, and ``all`` over every parameter.
-    """
-    counts: dict[str, list[bool]] = {}
-    for c in cases:
-        for name, held in c.covered.items():
-            counts.setdefault(name, []).append(held)
-    out = {n: {"share": sum(v) / len(v), "intervals": len(v)} for n, v in sorted(counts.items())}
-    every = [h for v in counts.values() for h in v]
-    if every:
-        out["all"] = {"share": sum(every) / len(every), "intervals": len(every)}
-    return out
-
-
-def trend_summary(cases: Sequence[Case]) -> dict[str, dict[str, float]]:
-    """Per truth: the share of campaigns whose baseline stiffness was flagged moving with rate."""
-    by_truth: dict[str, list[bool]] = {}
-    for c in cases:
-        flagged = "drive_rate_hz" in c.trends.get("stiffness_scale", "").split("+")
-        by_truth.setdefault(c.truth, []).append(flagged)
-    return {
-        t: {"stiffness_with_rate": sum(v) / len(v), "campaigns": len(v)}
-        for t, v in by_truth.items()
-    }
-
-
-def covered_truth(d: Diagnosis, effect: str, truth: dict[str, float]) -> dict[str, bool]:
-    """Whether each interval the diagnosis gives holds the true value (where it is known).
-
-    ``truth``: a same-form campaign's parameters (``make_campaign``): the baseline's
-    multipliers and the true ``effect``'s own parameters. Keys: the baseline's names and
-    ``effect.param``.
-    """
-    held = {}
-    for name, (lo, hi) in d.baseline_intervals.items():
-        if name in truth:
-            held[name] = bool(lo <= truth[name] <= hi)
-    for a in d.effects:
-        for name, (lo, hi) in a.intervals.items():
-            if a.effect == effect and name in truth and lo < hi:  # a held count has none
-                held[f"{effect}.{name}"] = bool(lo <= truth[name] <= hi)
-    return held
 
 
 def make_campaign(
@@ -416,7 +332,7 @@ def diagnose_case(
     case = Case(
         spec.truth, spec.mass_kg, d.effect, params, shrink, oracle_shrink, seconds, identifiable,
         d.verdict, named_effects(d), kinds,
-        covered_truth(d, spec.truth, params) if truth_stand == "same" else {}, trends,
+        summaries.covered_truth(d, spec.truth, params) if truth_stand == "same" else {}, trends,
     )  # fmt: skip
     return case, d
 

@@ -6,6 +6,8 @@ from __future__ import annotations
 #: other stand with effects outside the catalogue (``sim.checks.otherstand.outside``).
 TRUTHS = ("same", "other", "outside")
 MASSES_KG = (3.096, 8.131)
+#: A ``none`` campaign whose recorder adds artefacts (``Realism.with_artefacts``).
+ARTEFACTS = "artefacts"
 #: The recording sets a check can draw its campaigns with (``check.recording_set``): the
 #: other stand's (the validation campaigns' four drive signals are ``moderate``), and the
 #: paper-like quick, medium and slow recordings the first checks used.

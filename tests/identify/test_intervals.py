@@ -10,7 +10,8 @@ from scipy import stats
 
 from drivers.signals import plan_motion
 from labstand.commands.diagnose import _print_summary
-from sim.checks.check import CaseSpec, covered_truth, make_campaign, recording_set
+from sim.checks.check import CaseSpec, make_campaign, recording_set
+from sim.checks.summaries import covered_truth
 from sim.config import StandConfig
 from sim.effects import EffectSpec
 from sim.effects.realism import MeasurementNoise, NoiseSpec

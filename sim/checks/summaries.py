@@ -1,0 +1,91 @@
+"""What a check's campaigns add up to: verdicts, interval coverage, per-recording trends."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from typing import TYPE_CHECKING, Any
+
+from sim.checks.choices import ARTEFACTS
+from sim.checks.otherstand.outside import OUTSIDE_EFFECTS, SIGNATURE_KIND
+from sim.effects import EFFECTS
+from sim.identify.report import Diagnosis
+
+if TYPE_CHECKING:
+    from sim.checks.check import Case
+
+
+def verdict_summary(cases: Sequence[Case]) -> dict[str, Any]:
+    """What the verdicts say, by kind of truth (each share over its campaigns; None: none).
+
+    ``none``: none and artefact-only campaigns answered ``baseline_adequate``;
+    ``outside``: out-of-catalogue truths answered ``unexplained`` or
+    ``partly_explained``, with a catalogue effect named, with the best signature of the
+    truth's kind; ``catalogue``: single-effect truths whose named set is exactly the truth.
+    """
+
+    def share(selected: Sequence[Case], test: Callable[[Case], bool]) -> float | None:
+        return sum(map(test, selected)) / len(selected) if selected else None
+
+    nones = [c for c in cases if c.truth in ("none", ARTEFACTS)]
+    outside = [c for c in cases if c.truth in OUTSIDE_EFFECTS]
+    catalogue = [c for c in cases if c.truth in EFFECTS]
+    return {
+        "none_adequate": share(nones, lambda c: c.verdict == "baseline_adequate"),
+        "outside_flagged": share(
+            outside, lambda c: c.verdict in ("unexplained", "partly_explained")
+        ),
+        "outside_catalogue_named": share(outside, lambda c: bool(c.named)),
+        "outside_kind_right": share(
+            outside,
+            lambda c: bool(c.signature_kinds) and c.signature_kinds[0] == SIGNATURE_KIND[c.truth],
+        ),
+        "catalogue_exact": share(catalogue, lambda c: c.named == (c.truth,)),
+    }
+
+
+def coverage_summary(cases: Sequence[Case]) -> dict[str, dict[str, float]]:
+    """Per parameter (the baseline's and ``effect.param``): share of intervals holding the truth.
+
+    Counted where the truth is known and the diagnosis reported an interval for it: the
+    baseline's multipliers on same-form truths, an effect's parameters where the effect
+    was named. ``{name: {"share": s, "intervals": n}}``, and ``all`` over every parameter.
+    """
+    counts: dict[str, list[bool]] = {}
+    for c in cases:
+        for name, held in c.covered.items():
+            counts.setdefault(name, []).append(held)
+    out = {n: {"share": sum(v) / len(v), "intervals": len(v)} for n, v in sorted(counts.items())}
+    every = [h for v in counts.values() for h in v]
+    if every:
+        out["all"] = {"share": sum(every) / len(every), "intervals": len(every)}
+    return out
+
+
+def trend_summary(cases: Sequence[Case]) -> dict[str, dict[str, float]]:
+    """Per truth: the share of campaigns whose baseline stiffness was flagged moving with rate."""
+    by_truth: dict[str, list[bool]] = {}
+    for c in cases:
+        flagged = "drive_rate_hz" in c.trends.get("stiffness_scale", "").split("+")
+        by_truth.setdefault(c.truth, []).append(flagged)
+    return {
+        t: {"stiffness_with_rate": sum(v) / len(v), "campaigns": len(v)}
+        for t, v in by_truth.items()
+    }
+
+
+def covered_truth(d: Diagnosis, effect: str, truth: dict[str, float]) -> dict[str, bool]:
+    """Whether each interval the diagnosis gives holds the true value (where it is known).
+
+    ``truth``: a same-form campaign's parameters (``make_campaign``): the baseline's
+    multipliers and the true ``effect``'s own parameters. Keys: the baseline's names and
+    ``effect.param``.
+    """
+    held = {}
+    for name, (lo, hi) in d.baseline_intervals.items():
+        if name in truth:
+            held[name] = bool(lo <= truth[name] <= hi)
+    for a in d.effects:
+        for name, (lo, hi) in a.intervals.items():
+            if a.effect == effect and name in truth and lo < hi:  # a held count has none
+                held[f"{effect}.{name}"] = bool(lo <= truth[name] <= hi)
+    return held
