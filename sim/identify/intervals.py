@@ -150,10 +150,15 @@ def parameter_intervals(
         cov, clusters = sandwich_covariance(jac, residuals, labels)
         t = float(stats.t.ppf(0.5 + level / 2, max(clusters - 1, 1)))
         se_free = np.sqrt(np.maximum(np.diag(cov), 0.0))
+        # A parameter the outputs do not feel (its effect idle on these recordings) is
+        # not known at all: the pseudo-inverse would call it exact.
+        feel = np.linalg.norm(jac, axis=0)
+        se_free[feel <= 1e-9 * max(float(feel.max()), 1e-300)] = math.inf
         # The next slopes are secants over the interval itself (at least the fit's step,
         # at most half the range): a rugged objective's local slope is not the slope
         # over the distance the interval claims.
-        wanted = np.clip(t * se_free, steps[free], 0.5 * (hi_all - lo_all)[free])
+        wanted = np.clip(np.nan_to_num(t * se_free, posinf=np.inf), steps[free],
+                         0.5 * (hi_all - lo_all)[free])  # fmt: skip
         if np.allclose(wanted, steps[free], rtol=0.25):
             break
         steps[free] = wanted

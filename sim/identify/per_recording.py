@@ -127,13 +127,16 @@ def consistency(candidate: Candidate, fits: Sequence[RecordingFit]) -> dict[str,
     for name in names:
         theta = np.array([_internal(candidate, name, f.values[name]) for f in fits])
         se = np.array([f.sure.internal_se[name] * f.sure.widening for f in fits])
-        w = 1.0 / np.maximum(se, 1e-12) ** 2
+        # A recording that cannot tell a parameter (no interval) carries no weight.
+        w = np.where(np.isfinite(se) & (se > 0), 1.0 / np.maximum(se, 1e-300) ** 2, 0.0)
+        if np.count_nonzero(w) < 2:
+            continue
         mean = float(np.sum(w * theta) / np.sum(w))
         q = float(np.sum(w * (theta - mean) ** 2))
-        p = min(1.0, float(stats.chi2.sf(q, len(fits) - 1)) * len(names))
+        p = min(1.0, float(stats.chi2.sf(q, np.count_nonzero(w) - 1)) * len(names))
         entry: dict[str, Any] = {"p_value": p, "trend": None, "moves_with": None, "points_to": None}
-        free = next(q for q in candidate.params if q.name == name)
-        if all(free.at_bound(f.values[name]) for f in fits):
+        fitted = next(par for par in candidate.params if par.name == name)
+        if all(fitted.at_bound(f.values[name]) for f in fits):
             # Pinned: agreement says nothing, but every recording wants more than the range.
             entry["trend"] = f"{name} at the end of its range in every recording"
             entry["points_to"] = "more than the model's range allows: an effect it lacks"

@@ -214,3 +214,23 @@ def test_the_papers_situations_with_a_relaxation_branch_need_their_own_stiffness
     assert d.baseline_consistency["stiffness_scale"]["p_value"] < 0.05
     assert "fibre_viscoelastic" in d.baseline_consistency["stiffness_scale"]["points_to"]
     assert d.consistency["stiffness_scale"]["p_value"] >= 0.05
+
+
+def test_a_parameter_the_recordings_do_not_feel_has_no_interval(stand: StandConfig) -> None:
+    # A pulley seat that never moves (step 0): where it would start and how deep it
+    # sits change nothing the gauges read, so their intervals must say "anywhere in the
+    # range", not "exactly known" (a pseudo-inverse would give them zero width).
+    recordings = recording_set("moderate", stand)[2:]
+    spec = CaseSpec("none", HEAVY, 0, 3)
+    traces, _, truth = make_campaign(stand, "none", HEAVY, spec.rng(), recordings)
+    nominal = stand.stand_params("final", HEAVY)
+    candidate = Candidate.build("fibre_pulley_jump")
+    values = {p.name: truth.get(p.name, 0.5 * (p.low + p.high)) for p in candidate.params}
+    values["fibre_pulley_jump.step_m"] = 0.0
+    sure = parameter_intervals(candidate, values, traces, nominal)
+    for name in ("fibre_pulley_jump.depth_scale_m", "fibre_pulley_jump.onset_m"):
+        p = next(p for p in candidate.params if p.name == name)
+        assert sure.intervals[name] == pytest.approx((p.low, p.high)), name
+        assert name in sure.reaches_bound
+    lo, hi = sure.intervals["stiffness_scale"]
+    assert lo <= truth["stiffness_scale"] <= hi
