@@ -168,7 +168,9 @@ def _trend(
         found.append((float(2 * stats.norm.sf(abs(slope) * math.sqrt(sxx))), key, slope))
     found = sorted(f for f in found if f[0] * tried < CONSISTENCY_ALPHA)
     if not found:
-        return {"trend": "differs between recordings, following none of rate, stroke or mass"}
+        return {
+            "trend": f"{name} differs between recordings, following none of rate, stroke or mass"
+        }
     words = {k: w_ for k, w_, _ in COVARIATES}
     units = {k: u for k, _, u in COVARIATES}
     parts = [
