@@ -6,10 +6,17 @@ ends a Ctrl-C (cleanly) and says which it was: exit 143, "terminated".
 
 from __future__ import annotations
 
+import os
 import signal
+import sys
 import threading
 from collections.abc import Iterator
-from contextlib import contextmanager
+from contextlib import contextmanager, suppress
+from types import FrameType
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from labstand.session import StopRequest
 
 
 class Terminated(KeyboardInterrupt):
@@ -72,3 +79,28 @@ def remembered_interrupt(raise_now: bool = True) -> Iterator[Interrupt]:
     finally:
         for s, handler in previous.items():
             signal.signal(s, handler)
+
+
+@contextmanager
+def stop_presses(stop: StopRequest) -> Iterator[None]:
+    """Ctrl-C (and SIGTERM) count presses instead of raising, while the drive may move."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def handler(signum: int, frame: FrameType | None) -> None:
+        stop.press("SIGTERM" if signum == signal.SIGTERM else "Ctrl-C")
+        text = (
+            f"\nlabstand: {stop.by}: stopping in order (again: disable the drive at once)\n"
+            if stop.presses == 1
+            else "\nlabstand: disabling the drive at once\n"
+        )
+        with suppress(OSError):
+            os.write(sys.stderr.fileno(), text.encode())
+
+    old = {sig: signal.signal(sig, handler) for sig in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        yield
+    finally:
+        for sig, previous in old.items():
+            signal.signal(sig, previous)

@@ -1,3 +1,4 @@
+# Over 400 lines: one schema (every stream, dtype, unit and metadata field) that all formats read.
 """Schema version 1 of a recording: streams, their numpy dtypes, units, and the metadata.
 
 See docs/recording-format.md. A recording holds four streams:

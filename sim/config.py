@@ -1,3 +1,4 @@
+# Over 400 lines: the stand file validated key by key, each with its unit, range and message.
 """The stand configuration: a TOML file, validated key by key.
 
 The embedded ``default_stand.toml`` is the paper's stand. A user's file overlays it: it

@@ -14,15 +14,10 @@ import argparse
 import contextlib
 import logging
 import math
-import os
-import signal
 import sys
-import threading
 import time
-from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from types import FrameType
 from typing import TYPE_CHECKING, Any
 
 from drivers.signals import SignalSpec, plan_motion
@@ -35,6 +30,7 @@ from labstand.commands.common import (
 )
 from labstand.commands.simulate import add_signal_options, signal_from_args
 from labstand.errors import CommandError, ExitCode
+from labstand.interrupts import stop_presses
 from labstand.live.address import ViewerAddress, parse_address
 from labstand.prediction import Verdict, add_prediction_options, check_motion, fitted_from_args
 from labstand.session import (
@@ -276,7 +272,7 @@ def _session(
         with session.keepalive():
             _confirm()
     stop = StopRequest()
-    with _stop_signals(stop):
+    with stop_presses(stop):
         try:
             session.prepare(pre, stop)
         except EStopError as err:
@@ -356,31 +352,6 @@ def _confirm() -> None:
     answer = input("Start the run? The drive will move. [y/N] ").strip().lower()
     if answer not in {"y", "yes"}:
         raise CommandError("not confirmed; nothing moved", ExitCode.REFUSED)
-
-
-@contextlib.contextmanager
-def _stop_signals(stop: StopRequest) -> Iterator[None]:
-    """Ctrl-C (and SIGTERM) count presses instead of raising, while the drive may move."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-
-    def handler(signum: int, frame: FrameType | None) -> None:
-        stop.press("SIGTERM" if signum == signal.SIGTERM else "Ctrl-C")
-        text = (
-            f"\nlabstand: {stop.by}: stopping in order (again: disable the drive at once)\n"
-            if stop.presses == 1
-            else "\nlabstand: disabling the drive at once\n"
-        )
-        with contextlib.suppress(OSError):
-            os.write(sys.stderr.fileno(), text.encode())
-
-    old = {sig: signal.signal(sig, handler) for sig in (signal.SIGINT, signal.SIGTERM)}
-    try:
-        yield
-    finally:
-        for sig, previous in old.items():
-            signal.signal(sig, previous)
 
 
 def _report(result: RunResult, output: Path, sim: dict[str, Any]) -> int:

@@ -1,3 +1,4 @@
+# Over 400 lines: the term library, its taut-dynamics filters and its judge share one variant table.
 """What a remainder behaves like: a sparse regression on a library of physical terms.
 
 After the named effects (or the baseline alone) a remainder may stand. Its *signature*
