@@ -156,7 +156,9 @@ class UnidriveSP(DriveInterface):
                 last = err
                 log.warning("%s: %s: no reply (attempt %d)", self.name, what, attempt + 1)
                 continue
-            except ConnectionException as err:
+            except (ConnectionException, OSError) as err:
+                # pymodbus raises a reset socket's OSError as it comes (a stand killed
+                # mid-run): the link is lost all the same.
                 last = err
                 log.warning("%s: %s: link lost (attempt %d)", self.name, what, attempt + 1)
                 self._client.close()
@@ -178,7 +180,7 @@ class UnidriveSP(DriveInterface):
                 log.warning("%s: %s: garbled reply (attempt %d)", self.name, what, attempt + 1)
                 continue
             return reply
-        if isinstance(last, ConnectionException):
+        if isinstance(last, (ConnectionException, OSError)):
             raise DriveConnectionError(f"{self.name}: {what}: {last}") from last
         raise DriveTimeoutError(
             f"{self.name}: {what}: no reply after {self.retries + 1} attempts"

@@ -236,6 +236,10 @@ def test_lost_link_reconnects_or_raises(drive: UnidriveSP, client: InProcessClie
     with pytest.raises(DriveConnectionError) as err:
         drive.read(pr.TRIP_CODE)
     assert isinstance(err.value, ConnectionError)
+    # A stand killed mid-run: the socket's own reset, as pymodbus lets it through.
+    client.fail_next = [ConnectionResetError(104, "Connection reset by peer")] * 3
+    with pytest.raises(DriveConnectionError, match="reset by peer"):
+        drive.read(pr.TRIP_CODE)
 
 
 def test_close_disables_and_refuses_work(drive: UnidriveSP, sim: SimulatedDrive) -> None:
