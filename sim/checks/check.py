@@ -105,6 +105,8 @@ class Case:
     #: Per baseline parameter fitted per recording that moved: what it moved with
     #: (covariates joined by ``+`` where the recordings cannot tell them apart).
     trends: dict[str, str] = field(default_factory=dict)
+    #: Per baseline parameter fitted per recording whose spread points somewhere: to what.
+    points_to: dict[str, str] = field(default_factory=dict)
 
     @property
     def right(self) -> bool:
@@ -329,10 +331,12 @@ def diagnose_case(
         for k, v in d.baseline_consistency.items()
         if v["moves_with"]
     }
+    pointers = {k: v["points_to"] for k, v in d.baseline_consistency.items() if v["points_to"]}
     case = Case(
         spec.truth, spec.mass_kg, d.effect, params, shrink, oracle_shrink, seconds, identifiable,
         d.verdict, named_effects(d), kinds,
         summaries.covered_truth(d, spec.truth, params) if truth_stand == "same" else {}, trends,
+        pointers,
     )  # fmt: skip
     return case, d
 

@@ -24,7 +24,7 @@ from sim.identify.intervals import (
     parameter_intervals,
     sandwich_covariance,
 )
-from sim.identify.per_recording import RecordingFit, consistency, drive_of
+from sim.identify.per_recording import RecordingFit, consistency, drive_of, widened_baseline
 from sim.identify.traces import Trace
 from sim.model import Model
 from sim.situations import SITUATIONS
@@ -212,8 +212,19 @@ def test_the_papers_situations_with_a_relaxation_branch_need_their_own_stiffness
     assert min(alone[n] for n in quick) > min(alone[n] for n in slow)
     assert np.mean([alone[n] for n in quick]) > np.mean([alone[n] for n in slow])
     assert d.baseline_consistency["stiffness_scale"]["p_value"] < 0.05
-    assert "fibre_viscoelastic" in d.baseline_consistency["stiffness_scale"]["points_to"]
+    # What explains it: the branch, named through whichever parameter carries its rate
+    # dependence once each has room (the damping, falling with the rate, here).
+    pointers = [v["points_to"] or "" for v in d.baseline_consistency.values()]
+    assert any("fibre_viscoelastic" in text for text in pointers)
     assert d.consistency["stiffness_scale"]["p_value"] >= 0.05
+    # The branch's dissipation (k₂τ ≈ 600 N·s/m) is far beyond the catalogue's damping
+    # range (×4 of 27.5 N·s/m): the baseline alone's per-recording fit has room for it,
+    # so its damping is a measured value, not the range's end in every recording.
+    damping = [r["baseline_alone"]["params"]["damping_scale"] for _, r in fits]
+    widened = next(p for p in widened_baseline().params if p.name == "damping_scale")
+    assert min(damping) > 4.0
+    assert not any(widened.at_bound(v) for v in damping)
+    assert "at the end of its range" not in (d.baseline_consistency["damping_scale"]["trend"] or "")
 
 
 def test_a_parameter_the_recordings_do_not_feel_has_no_interval(stand: StandConfig) -> None:
