@@ -18,6 +18,7 @@ import pytest
 from labstand.campaigns import Campaign, diagnose_campaign, load_manifest
 from labstand.cli import main
 from labstand.distributed import ClusterOptions, Progress, open_client, run_jobs
+from labstand.distributed.cluster import THREAD_POOLS
 from sim.effects import EFFECTS
 from tests.hardware_sim.leakcheck import gone
 from tests.ptys import sigint_not_ignored
@@ -94,6 +95,11 @@ def test_a_dead_worker_costs_its_campaign_a_retry_and_a_bad_one_fails_alone(
     progress = Progress("test", 3, quiet=True)
     with open_client(ClusterOptions(workers=2), lambda _m: None) as (client, threads):
         assert threads == 1 or os.cpu_count() == 1
+        # Each worker's BLAS and OpenMP pools are capped as its numba threads: uncapped,
+        # every worker process starts one thread per core.
+        pools = client.run(lambda: {k: os.environ.get(k) for k in THREAD_POOLS})
+        assert len(pools) == 2
+        assert all(env == dict.fromkeys(THREAD_POOLS, str(threads)) for env in pools.values())
         results = run_jobs(
             client,
             lambda job: job[0](job[1]),
