@@ -3,7 +3,8 @@
 The model is one text in four parts — this head, ``fibre`` (the fibre in one segment or
 two, the weight, the friction table: constants, forces, right-hand side), ``integrator`` (RK4 /
 ETDRK4 steps split at located events, substeps) and ``runners`` (from rest, batch,
-segments, chained, block by block) — then each composed term's ``terms.py``. It is never
+segments, chained, block by block) — then each composed term's ``terms.py`` (an added
+effect's: the compiled functions of its one file, ``EffectInfo.terms``). It is never
 imported as itself: ``sim.physics.compose`` writes it, composed for a set of terms, into
 one hash-named module (the head's marked blocks: the layout's constants, the state's
 tuple helpers, the terms' hook calls; ``fibre``'s: the added effects' forces; the splice
@@ -265,6 +266,12 @@ def _terms_friction(c, v, zone, t2, fric):  # type: ignore[no-untyped-def]
     """The composed terms' ``friction`` hooks."""
     fric = sl_friction(c, v, zone, t2, fric)
     return fric
+
+
+@njit(cache=True, error_model="numpy")
+def _terms_weight(c, y, v, t2, drive):  # type: ignore[no-untyped-def]
+    """The composed terms' ``weight`` hooks."""
+    return drive
 
 
 @njit(cache=True, error_model="numpy")
