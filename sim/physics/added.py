@@ -29,12 +29,12 @@ def check(info: EffectInfo, others: tuple[EffectInfo, ...]) -> None:
         )
     if info.weight_force is not None and not hasattr(info.weight_force, "py_func"):
         raise EffectError(f"{info.name}: its weight_force must be compiled (njit)")
-    symbol = info.symbol
-    if not (symbol.isidentifier() and symbol.isupper()):
-        raise EffectError(f"{info.name}: its symbol {symbol!r} must be an upper-case name")
-    taken = _RESERVED | {other.symbol for other in others}
-    if symbol in taken:
-        raise EffectError(f"{info.name}: the symbol {symbol} is taken; choose another")
+    if info.terms is not None:  # its hooks' and names' prefix: its own
+        symbol = info.symbol
+        if not (symbol.isidentifier() and symbol.isupper()):
+            raise EffectError(f"{info.name}: its symbol {symbol!r} must be an upper-case name")
+        if symbol in _RESERVED | {other.symbol for other in others if other.terms}:
+            raise EffectError(f"{info.name}: the symbol {symbol} is taken; choose another")
     for names, what in ((info.states, "state"), (info.slots, "slot")):
         bad = [n for n in names if not (n.isidentifier() and n.isupper())] or [
             n for n in names if names.count(n) > 1

@@ -146,7 +146,8 @@ def constants(terms: tuple[str, ...], added: tuple[EffectInfo, ...] = ()) -> dic
     for symbol in TERMS:
         values[f"ON_{symbol}"] = int(symbol in terms)
     for info in added:
-        values.update(added_names(info))
+        if info.terms:  # a force alone reads its columns as compose writes them
+            values.update(added_names(info))
     values["ON_X"] = int(any(info.weight_force is not None for info in added))
     # The most fibre segments the set has: the pulley's rim splits the fibre in two.
     values["SEGMENTS"] = 2 if "PI" in terms else 1
