@@ -5,12 +5,14 @@ hand: the row holds the baseline's eight parameters (``sim.model``'s order), the
 geometry, then per effect its flag (1.0 on) and its parameters as it declares them, then
 the block of effects added with ``register``. The constants array c of one run holds the
 row, then the derived constants (``D_*``), the discrete state (``S_*``), the exponential
-step's cache (``E_*``) and the friction table (``C_TABLE``). The names are the kernel's
-(``sim/physics/kernel.py``): an effect's flag ``R_<symbol>_ON``, its parameters
-``R_<symbol>_<parameter symbol>``, both symbols declared in its module.
+step's cache (``E_*``), the added effects' slots (from ``S_X``) and the friction table
+(``C_TABLE``). The names are the kernel's (``sim/physics/kernel.py``): an effect's flag
+``R_<symbol>_ON``, its parameters ``R_<symbol>_<parameter symbol>``, both symbols
+declared in its module; an added effect's slots ``S_<symbol>_<slot>``.
 
 The state y is a tuple of the composed set's states in one order (``STATES``): the
-baseline's u, v, then each term's own. Plain Python: reading it loads no numba.
+baseline's u, v, then each term's own, then the added effects' (``every_state``:
+``Y_<symbol>_<state>``). Plain Python: reading it loads no numba.
 """
 
 from __future__ import annotations
@@ -146,7 +148,7 @@ def constants(terms: tuple[str, ...], added: tuple[EffectInfo, ...] = ()) -> dic
     for symbol in TERMS:
         values[f"ON_{symbol}"] = int(symbol in terms)
     for info in added:
-        if info.terms:  # a force alone reads its columns as compose writes them
+        if info.terms:  # a force alone gets its columns in ``_added_force``'s call
             values.update(added_names(info))
     values["ON_X"] = int(any(info.weight_force is not None for info in added))
     # The most fibre segments the set has: the pulley's rim splits the fibre in two.
