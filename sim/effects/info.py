@@ -170,6 +170,20 @@ class EffectInfo:
     #: (``sim.physics.compose``). None for the nine of STAND.md §5, whose terms the
     #: kernel holds.
     weight_force: Any = None
+    #: An effect added outside the kernel with terms of its own: the name of the module
+    #: (``__name__`` in its one file) whose compiled hooks ``<symbol>_<hook>`` (the hooks
+    #: of ``sim.physics.kernel_source``) and helpers ``_<symbol>_…`` the model composes in,
+    #: as it does the built-in terms (``sim.physics.added``). None: none.
+    terms: str | None = None
+    #: Its continuous states (``terms``): appended after the built-in ones, named
+    #: ``Y_<symbol>_<state>`` in its hooks; their values at rest, rates and values at a
+    #: measured start come from its ``rest``, ``rates`` and ``start_state`` hooks.
+    states: tuple[str, ...] = ()
+    #: Its discrete state and derived constants (``terms``): one value each in the
+    #: constants array c, named ``S_<symbol>_<slot>`` in its hooks (its ``pack`` sets
+    #: constants, its ``after_part`` flips a switch, its ``start`` sets them at a measured
+    #: start).
+    slots: tuple[str, ...] = ()
     #: How its form can be generalised: the remainder signature variants (kind, channel:
     #: ``sim.identify.signature.VARIANTS``) that a richer form of it would add. A further
     #: effect on top of this one is named only if it beats them (a second effect must not
@@ -188,6 +202,13 @@ class EffectInfo:
     #: Its flag's index in the parameter row (its parameters follow): given by the
     #: registry from its place in the registry's order (``sim.physics.layout``).
     flag_column: int = -1
+    #: Its first slot's index in c: given by ``register`` (the block from ``layout.S_X``).
+    slot_index: int = -1
+
+    @property
+    def added(self) -> bool:
+        """Added outside the kernel with ``register`` (a compiled force or terms of its own)."""
+        return self.weight_force is not None or self.terms is not None
 
     def param(self, name: str) -> ParamInfo:
         """A parameter by name (EffectError if unknown)."""

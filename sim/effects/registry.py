@@ -12,10 +12,10 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from sim.effects.info import EffectError, EffectInfo, ParamInfo
-from sim.physics import layout
+from sim.physics import added, layout
 
 __all__ = [
     "EFFECTS",
@@ -117,23 +117,32 @@ def check_unique(specs: Iterable[EffectSpec]) -> None:
 def register(info: EffectInfo) -> EffectInfo:
     """Add an effect defined outside the kernel (a tenth one): its own module, one call.
 
-    The effect brings a compiled ``weight_force`` (see ``EffectInfo``); its flag and
-    parameters get the next free columns of the kernel row's extension block (the
-    columns ``info`` gives are ignored), and a model with it switched on runs a kernel
-    composed with its force (``sim.physics.compose``). Returns the registered info, as
-    ``EFFECTS`` now holds it; ``unregister`` removes it again.
+    The effect brings a compiled ``weight_force``, or terms of its own (``terms``: its
+    hooks, with its continuous ``states`` and its discrete ``slots``), or both (see
+    ``EffectInfo`` and docs/architecture.md); ``sim.physics.added.check`` refuses what the
+    model cannot compose. Its flag and parameters get the next free columns of the kernel
+    row's extension block, its slots the next of the constants' (the columns and slot
+    ``info`` gives are ignored), and a model with it switched on runs a kernel composed
+    with it (``sim.physics.compose``). Returns the registered info, as ``EFFECTS`` now
+    holds it; ``unregister`` removes it again.
     """
     if info.name in EFFECTS:
         raise EffectError(f"an effect named {info.name!r} is already registered")
-    if info.weight_force is None or not hasattr(info.weight_force, "py_func"):
-        raise EffectError(f"{info.name}: an added effect needs a compiled (njit) weight_force")
-    used = [c for e in EFFECTS.values() if e.weight_force is not None for c in _columns(e)]
+    others = tuple(e for e in EFFECTS.values() if e.added)
+    added.check(info, others)
+    used = [c for e in others for c in _columns(e)]
     first = max(used, default=layout.R_X - 1) + 1
     if first + len(info.params) >= layout.R_X + layout.N_X:
         raise EffectError(
             f"{info.name}: no room in the kernel row ({layout.N_X} columns for added effects)"
         )
+    slot = added.slot_range(others)
+    if slot + len(info.slots) > layout.S_X + layout.N_SX:
+        raise EffectError(
+            f"{info.name}: no room for its slots ({layout.N_SX} for added effects' slots)"
+        )
     (registered,), _ = layout.place((info,), first)
+    registered = replace(registered, slot_index=slot)
     EFFECTS[info.name] = registered
     return registered
 
@@ -141,7 +150,7 @@ def register(info: EffectInfo) -> EffectInfo:
 def unregister(name: str) -> None:
     """Remove an effect ``register`` added (the nine of STAND.md §5 stay)."""
     info = effect_info(name)
-    if info.weight_force is None:
+    if not info.added:
         raise EffectError(f"{name} is one of the kernel's own effects; it cannot be removed")
     del EFFECTS[name]
 

@@ -8,8 +8,9 @@
   stream): the compiled model's text, never imported as itself; each physical effect's
   terms are in ``sim/effects/NAME/terms.py``;
 * ``kernel_source`` and ``compose``: that text written for a set of terms (the empty set
-  is the baseline; else the built-in union plus any added effects' forces) into one
-  hash-named module;
+  is the baseline; else the built-in union plus any added effects: their forces, their
+  terms from their one file) into one hash-named module; ``added``: what ``register``
+  checks before it adds an effect;
 * ``runs`` and ``starts``: the runs behind ``Model`` (rows, batches, segments, stream)
   and the segments' start states from measurements.
 """

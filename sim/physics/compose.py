@@ -3,16 +3,20 @@
 ``kernel.py`` holds the integrator, the runners and the built-in effects' terms. A model
 runs a copy of it composed for its set: the layout's constants written in as literals
 (``layout.constants``: which terms are in, where each state sits), the state's tuple
-helpers written for the set's states, and ``_added_force`` summing the forces of the
-effects added with ``register``. A term that is out is pruned at compile time, so the
-empty set is the baseline at the baseline's speed and, with the arithmetic of every
-kept term unchanged, bit for bit what the union gives with every effect off. Two sets
+helpers written for the set's states, ``_added_force`` summing the forces of the
+effects added with ``register``, and the hooks of added effects with terms of their own
+(``EffectInfo.terms``: their states after the union's, their slots in c's block from
+``layout.S_X``), written in as the built-in terms' are. A term that is out is pruned at
+compile time, so the empty set is the baseline at the baseline's speed and, with the
+arithmetic of every kept term unchanged, bit for bit what the union gives with every
+effect off. Two sets
 are composed: the empty one and the union of the built-in terms (with any added
-effects' forces) — compiled once each, like numba compiled the two kernels before.
+effects) — compiled once each, like numba compiled the two kernels before.
 
 The file's name is a hash of its whole text (the kernel's source, the layout, each added
-effect's module source, numba's and Python's versions): numba's cache does not notice an
-edit of a jitted function or a constant imported from another module; a new name does.
+effect's composed functions and its force's module source, numba's and Python's
+versions): numba's cache does not notice an edit of a jitted function or a constant
+imported from another module; a new name does.
 Composed modules are written to ``cache_dir()`` and numba caches their machine code
 beside them.
 """
@@ -91,9 +95,9 @@ def _composed(terms: tuple[str, ...], added: tuple[EffectInfo, ...]) -> ModuleTy
 
 def source_for(terms: tuple[str, ...], added: tuple[EffectInfo, ...] = ()) -> str:
     """The kernel's source composed for a set: its three marked blocks written for it."""
-    text = kernel_source.text(terms)
+    text = kernel_source.text(terms, added)
     names = ", ".join(terms + tuple(info.name for info in added)) or "none (the baseline)"
-    values = layout.constants(terms, bool(added))
+    values = layout.constants(terms, added)
     head = [
         f"# <layout> composed for: {names}",
         f"# numba {numba.__version__}, Python {sys.version.split()[0]}",
@@ -101,16 +105,17 @@ def source_for(terms: tuple[str, ...], added: tuple[EffectInfo, ...] = ()) -> st
         "",
     ]
     text = kernel_source.splice(text, "layout", "\n".join(head))
-    text = kernel_source.splice(text, "state", kernel_source.state_block(terms))
-    text = kernel_source.splice(text, "hooks", kernel_source.hooks_block(terms))
-    text = kernel_source.splice_sites(text, terms)
+    text = kernel_source.splice(text, "state", kernel_source.state_block(terms, added))
+    text = kernel_source.splice(text, "hooks", kernel_source.hooks_block(terms, added))
+    text = kernel_source.splice_sites(text, terms, added)
     return kernel_source.splice(text, "added-force", _added_block(added))
 
 
 def _added_block(added: tuple[EffectInfo, ...]) -> str:
     """``_added_force``: the sum of the added effects' forces that are on."""
     lines = ["# <added-force>"]
-    for i, info in enumerate(added):
+    forces = [info for info in added if info.weight_force is not None]
+    for i, info in enumerate(forces):
         func = info.weight_force.py_func
         module = sys.modules[func.__module__]
         digest = hashlib.sha256(inspect.getsource(module).encode()).hexdigest()[:20]
@@ -123,7 +128,7 @@ def _added_block(added: tuple[EffectInfo, ...]) -> str:
         '    """Force on the weight (N, up the incline) of the added effects that are on."""',
         "    force = 0.0",
     ]
-    for i, info in enumerate(added):
+    for i, info in enumerate(forces):
         values = "".join(f"c[{p.column}], " for p in info.params)
         lines += [
             f"    if c[{info.flag_column}] > 0.0:  # {info.name}",

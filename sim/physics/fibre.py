@@ -28,6 +28,7 @@ from sim.physics.kernel import (
     _terms_rest,
     _terms_segments,
     _terms_settle,
+    _terms_weight,
     _terms_zoned,
 )
 from sim.physics.layout import *
@@ -187,6 +188,10 @@ def _rhs(c, y, xa, xd):  # type: ignore[no-untyped-def]
     drive += c[P_PROJ] * t2  # + 0.0 while slack: the baseline's sum, bit for bit
     if ON_X and c[R_X_ON] > 0.0:
         drive += _added_force(c, y, t2)
+    # A term's own force on the weight (an added effect's, reading its states).
+    # <splice weight>
+    drive = _terms_weight(c, y, v, t2, drive)
+    # </splice weight>
     acc = drive / c[P_MASS]
     # <splice rates>
     return _terms_rates(c, y, sg, t1, t2, zd, v, acc)  # with the terms' rates

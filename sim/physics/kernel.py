@@ -1,17 +1,16 @@
 """The compiled model's head: its layout, state helpers and constants (source text only).
 
-The model is one text in four parts — this head, ``fibre`` (the fibre in one segment or
-two, the weight, the friction table: constants, forces, right-hand side), ``integrator`` (RK4 /
-ETDRK4 steps split at located events, substeps) and ``runners`` (from rest, batch,
-segments, chained, block by block) — then each composed term's ``terms.py``. It is never
-imported as itself: ``sim.physics.compose`` writes it, composed for a set of terms, into
-one hash-named module (the head's marked blocks: the layout's constants, the state's
-tuple helpers, the terms' hook calls; ``fibre``'s: the added effects' forces; the splice
-sites of ``fibre`` and ``integrator``: the bodies of the composed terms' hooks on the
-right-hand side's path, ``kernel_source.SPLICED``).
-The empty set is the baseline of STAND.md §2; the union has every built-in term, and an
-effect switched off in a row adds exact zeros, so both give the baseline's numbers bit
-for bit with every effect off.
+The model is one text: this head, ``fibre`` (the fibre in one segment or two, the
+weight, the friction table: constants, forces, right-hand side), ``integrator`` (RK4 /
+ETDRK4 steps split at located events, substeps), ``runners`` (from rest, batch, segments,
+chained, block by block), then each composed term's ``terms.py`` (an added effect's: the
+compiled functions of its one file). Never imported as itself: ``sim.physics.compose``
+writes it, composed for a set of terms, into one hash-named module (the head's marked
+blocks: the layout's constants, the state's tuple helpers, the terms' hook calls;
+``fibre``'s: the added effects' forces; the splice sites of ``fibre`` and
+``integrator``: the bodies of the composed terms' hooks on the right-hand side's path,
+``kernel_source.SPLICED``). The empty set is the baseline of STAND.md §2; the union has
+every built-in term; an effect switched off adds exact zeros (bit for bit the baseline).
 
 The baseline (state u, v: the weight's displacement up the incline and its velocity).
 The drive position x is given at the sample times and is linear inside each sample
@@ -36,20 +35,18 @@ each taut (T = kδ + cδ̇ + q) or slack, re-checked at every step's start. Thei
 string-mode amplitudes and rates a₁, ȧ₁ (drive span), a₂, ȧ₂ (weight span); LuGre
 bristle z. The run's constants live in one array c (``layout``): the parameter row,
 derived constants, the discrete state (taut flags, friction branch, pulley-jump seat and
-slack episode, bearing presliding) and the friction table. Stiff terms raise the RK4
-substeps per sample from estimates of their fastest rates (``_substeps``) and take the
-exponential step (``_etdrk4``) where it pays.
+slack episode, bearing presliding; the added effects' slots) and the friction table.
+Stiff terms raise the substeps (``_substeps``) and take the exponential step where it pays.
 
 Speed: the hot functions take c and scalars or tuples only; passing arrays to small
 jitted functions costs 7 machine words per array per call (measured: 60 → 9 ms for 10 s
 at 2 kHz). A term that is out of the set is not written in, and the second segment's
-branches are pruned at compile time (``SEGMENTS``), so the baseline runs on two states without the
-terms' branches. The hooks on the right-hand side's path are written in place, not
-called (``kernel_source.SPLICED``: called, they made the union 3–4.5× slower). All numba
-code of the model is composed into one text on purpose: numba's cache does not notice
-changes in jitted functions or constants imported from other modules; a composed
-module's name is a hash of its whole text instead. The parts' and the terms' import
-blocks are for reading and linting only.
+branches are pruned at compile time (``SEGMENTS``): the baseline runs on two states. The
+hooks on the right-hand side's path are written in place, not called (``SPLICED``:
+called, they made the union 3–4.5× slower). All numba code of the model is composed into
+one text on purpose: numba's cache does not notice changes in jitted functions or
+constants imported from other modules; a composed module's name is a hash of its whole
+text instead. The parts' and the terms' import blocks are for reading and linting only.
 """
 
 from __future__ import annotations
@@ -265,6 +262,12 @@ def _terms_friction(c, v, zone, t2, fric):  # type: ignore[no-untyped-def]
     """The composed terms' ``friction`` hooks."""
     fric = sl_friction(c, v, zone, t2, fric)
     return fric
+
+
+@njit(cache=True, error_model="numpy")
+def _terms_weight(c, y, v, t2, drive):  # type: ignore[no-untyped-def]
+    """The composed terms' ``weight`` hooks."""
+    return drive
 
 
 @njit(cache=True, error_model="numpy")

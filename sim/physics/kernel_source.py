@@ -11,13 +11,18 @@ others exist.
 from __future__ import annotations
 
 import ast
+import importlib
 from pathlib import Path
 
+from sim.effects.info import EffectInfo
 from sim.physics import layout
 
 __all__ = [
     "HOOKS",
     "SPLICED",
+    "STATE_HOOKS",
+    "added_file",
+    "composed_functions",
     "hooks_block",
     "splice",
     "splice_sites",
@@ -47,6 +52,7 @@ HOOKS: dict[str, tuple[tuple[str, ...], tuple[str, ...] | None]] = {
     "branch": (("c", "y", "q1", "q2"), ("q1", "q2")),  # force in each segment's tension law
     "friction_law": (("c", "y", "v", "replaced", "fric", "zd"), ("replaced", "fric", "zd")),
     "friction": (("c", "v", "zone", "t2", "fric"), ("fric",)),  # added guide friction, N
+    "weight": (("c", "y", "v", "t2", "drive"), ("drive",)),  # force on the weight, N, up
     "decay": (("c", "v", "rate"), ("rate",)),  # its state's decay for the exponential step
     # this interval's oscillations and decays, 1/s (maxima)
     "substeps": (
@@ -83,32 +89,66 @@ STATE_HOOKS: dict[str, tuple[tuple[str, ...], tuple[str, ...], dict[str, str]]] 
 #: and LLVM from simplifying the segments' and forces' arithmetic (measured: the union
 #: ran 3–4.5× slower with these hooks called, even with ``inline="always"``).
 SPLICED = (
-    "extension", "branch", "segments", "friction_law", "friction", "rates", "settle",
-    "after_part", "substeps",
+    "extension", "branch", "segments", "friction_law", "friction", "weight", "rates",
+    "settle", "after_part", "substeps",
 )  # fmt: skip
 
+Added = tuple[EffectInfo, ...]
 
-def term_files(terms: tuple[str, ...]) -> list[tuple[str, Path]]:
-    """(symbol, path) of the composed built-in terms that live in their effect's folder."""
+
+def term_files(terms: tuple[str, ...], added: Added = ()) -> list[tuple[str, Path]]:
+    """(symbol, path) of the composed terms' files, the built-in ones', then the added ones'.
+
+    A built-in term lives in its effect's folder, an added effect's in its one file.
+    """
     effects = Path(__file__).parent.parent / "effects"
     found = []
     for info in layout.PLACED:
         path = effects / info.name / "terms.py"
         if info.symbol in terms and path.exists():
             found.append((info.symbol, path))
-    return found
+    return found + [(info.symbol, added_file(info)) for info in added if info.terms]
 
 
-def _body(path: Path) -> str:
-    return path.read_text(encoding="utf-8").split("# </imports>\n", 1)[1]
+def added_file(info: EffectInfo) -> Path:
+    """The file of an added effect's terms (``EffectInfo.terms``, a module's name)."""
+    assert info.terms is not None
+    module = importlib.import_module(info.terms)
+    if module.__file__ is None:
+        raise ValueError(f"{info.name}: its terms' module {info.terms} has no file")
+    return Path(module.__file__)
 
 
-def text(terms: tuple[str, ...] = layout.TERMS) -> str:
+def composed_functions(path: Path, symbol: str) -> list[ast.FunctionDef]:
+    """An added effect's functions that the model composes in: ``<sym>_…`` and ``_<sym>_…``."""
+    prefix = f"{symbol.lower()}_"
+    return [
+        node
+        for node in ast.parse(path.read_text(encoding="utf-8")).body
+        if isinstance(node, ast.FunctionDef) and node.name.removeprefix("_").startswith(prefix)
+    ]
+
+
+def _body(path: Path, symbol: str = "") -> str:
+    """A built-in term file's text after its imports; an added effect's composed functions."""
+    source = path.read_text(encoding="utf-8")
+    if not symbol:
+        return source.split("# </imports>\n", 1)[1]
+    lines = source.splitlines()
+    texts = []
+    for node in composed_functions(path, symbol):  # from its decorator to its end
+        first = node.decorator_list[0].lineno if node.decorator_list else node.lineno
+        texts.append("\n".join(lines[first - 1 : node.end_lineno]))
+    return "\n\n\n".join(texts) + "\n"
+
+
+def text(terms: tuple[str, ...] = layout.TERMS, added: Added = ()) -> str:
     """The model's whole text: the head, each part, each composed term's file (no imports)."""
     here = Path(__file__).parent
     texts = [(here / "kernel.py").read_text(encoding="utf-8")]
     texts += [_body(here / name) for name in PARTS]
     texts += [_body(path) for _, path in term_files(terms)]
+    texts += [_body(added_file(info), info.symbol) for info in added if info.terms]
     return "\n".join(texts)
 
 
@@ -120,13 +160,14 @@ def _def(name: str, args: tuple[str, ...]) -> list[str]:
     return [f"def {name}(  # type: ignore[no-untyped-def]", f"    {', '.join(args)}", "):"]
 
 
-def hooks_block(terms: tuple[str, ...]) -> str:
+def hooks_block(terms: tuple[str, ...], added: Added = ()) -> str:
     """``_terms_<hook>``: each hook of the composed terms' files, called in order."""
     defined = {
         symbol: {n.name for n in ast.parse(path.read_text(encoding="utf-8")).body
                  if isinstance(n, ast.FunctionDef)}
-        for symbol, path in term_files(terms)
+        for symbol, path in term_files(terms, added)
     }  # fmt: skip
+    states = layout.every_state(added)
     lines = [f"# <hooks>: written by ``kernel_source.hooks_block`` for: {', '.join(defined)}."]
     flags = "".join(f" + c[R_{symbol}_ON]" for symbol in defined)
     lines += ["", "", _NJIT, "def _terms_on(c):  # type: ignore[no-untyped-def]",
@@ -154,12 +195,12 @@ def hooks_block(terms: tuple[str, ...]) -> str:
         value = dict(given)
         for symbol, functions in defined.items():
             func = f"{symbol.lower()}_{hook}"
-            own = [name.lower() for name, owner in layout.STATES if owner == symbol]
+            own = [name.lower() for name, owner in states if owner == symbol]
             if func in functions and own:
                 targets = ", ".join(f"r_{n}" for n in own)
                 body.append(f"    ({targets},) = {func}({', '.join(args)})")
                 value.update({n.upper(): f"r_{n}" for n in own})
-        every = ", ".join(value.get(name, "0.0") for name, _ in layout.STATES)
+        every = ", ".join(value.get(name, "0.0") for name, _ in states)
         doc = f"The whole state: the composed terms' ``{hook}`` hooks give their own."
         lines += ["", "", _NJIT, *_def(f"_terms_{hook}", args + extra),
                   f'    """{doc}"""', *body, f"    return _state({every})"]  # fmt: skip
@@ -178,13 +219,13 @@ def block(source: str, name: str) -> str:
     return source[source.index(f"# <{name}>") : source.index(f"# </{name}>")]
 
 
-def state_block(terms: tuple[str, ...]) -> str:
+def state_block(terms: tuple[str, ...], added: Added = ()) -> str:
     """The tuple helpers for the states of a set of terms (``layout.state_names``)."""
-    names = layout.state_names(terms)
+    names = layout.state_names(terms, added)
     n = len(names)
     at = {name: i for i, name in enumerate(names)}
-    every = [name for name, _ in layout.STATES]
-    carried = [at[name] for name in layout.CARRIED if name in at]
+    every = [name for name, _ in layout.every_state(added)]
+    carried = [at[name] for name in layout.carried(added) if name in at]
 
     def tup(items: list[str]) -> str:
         return "(" + ", ".join(items) + ("," if len(items) == 1 else "") + ")"
@@ -262,9 +303,10 @@ def _hook_body(path: Path, func: str, args: tuple[str, ...], targets: str) -> li
     return [line[indent:] for line in head] + [f"{targets} = {value}"]
 
 
-def splice_sites(source: str, terms: tuple[str, ...]) -> str:
+def splice_sites(source: str, terms: tuple[str, ...], added: Added = ()) -> str:
     """``source`` with each ``SPLICED`` hook's call replaced by the composed terms' bodies."""
-    files = term_files(terms)
+    files = term_files(terms, added)
+    states = layout.every_state(added)
     for hook in SPLICED:
         start = source.index(f"# <splice {hook}>")
         end = source.index(f"# </splice {hook}>")
@@ -282,13 +324,13 @@ def splice_sites(source: str, terms: tuple[str, ...]) -> str:
             args, _, given = STATE_HOOKS[hook]
             value = dict(given)
             for symbol, path in files:
-                own = [name for name, owner in layout.STATES if owner == symbol]
+                own = [name for name, owner in states if owner == symbol]
                 func = f"{symbol.lower()}_{hook}"
                 if own and f"def {func}(" in path.read_text(encoding="utf-8"):
                     targets = "(" + ", ".join(f"r_{n.lower()}" for n in own) + ",)"
                     written += _hook_body(path, func, args, targets)
                     value.update({n: f"r_{n.lower()}" for n in own})
-            every = ", ".join(value.get(name, "0.0") for name, _ in layout.STATES)
+            every = ", ".join(value.get(name, "0.0") for name, _ in states)
             written.append(f"return _state({every})")
         # The marker, the written bodies in place of the call's statement, the indent.
         body = [indent + line if line else line for line in written]

@@ -5,12 +5,14 @@ hand: the row holds the baseline's eight parameters (``sim.model``'s order), the
 geometry, then per effect its flag (1.0 on) and its parameters as it declares them, then
 the block of effects added with ``register``. The constants array c of one run holds the
 row, then the derived constants (``D_*``), the discrete state (``S_*``), the exponential
-step's cache (``E_*``) and the friction table (``C_TABLE``). The names are the kernel's
-(``sim/physics/kernel.py``): an effect's flag ``R_<symbol>_ON``, its parameters
-``R_<symbol>_<parameter symbol>``, both symbols declared in its module.
+step's cache (``E_*``), the added effects' slots (from ``S_X``) and the friction table
+(``C_TABLE``). The names are the kernel's (``sim/physics/kernel.py``): an effect's flag
+``R_<symbol>_ON``, its parameters ``R_<symbol>_<parameter symbol>``, both symbols
+declared in its module; an added effect's slots ``S_<symbol>_<slot>``.
 
 The state y is a tuple of the composed set's states in one order (``STATES``): the
-baseline's u, v, then each term's own. Plain Python: reading it loads no numba.
+baseline's u, v, then each term's own, then the added effects' (``every_state``:
+``Y_<symbol>_<state>``). Plain Python: reading it loads no numba.
 """
 
 from __future__ import annotations
@@ -80,7 +82,11 @@ E_ON, E_RIM, E_OSC, E_RATE, E_H, E_W = range(S_SLACKT + 1, S_SLACKT + 7)
 # The pulley seat follows the recorded slack episodes, not the model's: 1.0 while a run
 # is given them.
 S_RECSEAT = E_W + 6
-C_TABLE = S_RECSEAT + 1  # c[C_TABLE] = knots n, then the n knots, then coef (4, n − 1) by rows
+# Effects added with ``register``: their discrete states and derived constants (``slots``)
+# in the N_SX values from S_X.
+S_X = S_RECSEAT + 1
+N_SX = 8
+C_TABLE = S_X + N_SX  # c[C_TABLE] = knots n, then the n knots, then coef (4, n − 1) by rows
 
 # A segment's measured start (``kernel.measured_state``): columns of init[b, s]. I_FRATE:
 # the recorded force's rate (the force gauge filter's state, ``sim.effects.measure``).
@@ -102,27 +108,50 @@ TERMS = tuple(i.symbol for i in PLACED if i.kind == "physical")
 NY = 11
 
 
-def state_names(terms: tuple[str, ...]) -> tuple[str, ...]:
-    """The states of a composed set of terms, in order."""
-    return tuple(name for name, owner in STATES if not owner or owner in terms)
+def every_state(added: tuple[EffectInfo, ...] = ()) -> tuple[tuple[str, str], ...]:
+    """``STATES``, then the added effects' own (``<symbol>_<state>``), each with its owner."""
+    return STATES + tuple((f"{i.symbol}_{s}", i.symbol) for i in added for s in i.states)
 
 
-def constants(terms: tuple[str, ...], added: bool) -> dict[str, int]:
-    """Every layout constant of a composed kernel with these built-in terms.
+def carried(added: tuple[EffectInfo, ...] = ()) -> tuple[str, ...]:
+    """``CARRIED``, then the states of the added effects that carry theirs."""
+    return CARRIED + tuple(f"{i.symbol}_{s}" for i in added if i.carried for s in i.states)
+
+
+def state_names(terms: tuple[str, ...], added: tuple[EffectInfo, ...] = ()) -> tuple[str, ...]:
+    """The states of a composed set of built-in terms and added effects, in order."""
+    symbols = set(terms) | {info.symbol for info in added}
+    return tuple(name for name, owner in every_state(added) if not owner or owner in symbols)
+
+
+def added_names(info: EffectInfo) -> dict[str, int]:
+    """An added effect's names as its hooks read them: columns, slots (not its states)."""
+    names = {f"R_{info.symbol}_ON": info.flag_column}
+    names.update({f"R_{info.symbol}_{p.symbol}": p.column for p in info.params})
+    names.update({f"S_{info.symbol}_{s}": info.slot_index + i for i, s in enumerate(info.slots)})
+    return names
+
+
+def constants(terms: tuple[str, ...], added: tuple[EffectInfo, ...] = ()) -> dict[str, int]:
+    """Every layout constant of a composed kernel with these built-in terms, added effects.
 
     ``Y_*`` index the set's states (-1: a state the set lacks, only read in code its
     ``ON_*`` switch prunes); ``ON_<symbol>`` says whether a term is composed in, ``ON_X``
-    whether added effects' forces are.
+    whether added effects' forces (``weight_force``) are. An added effect's own names
+    (``added_names``, ``Y_<symbol>_<state>``) come with it.
     """
-    names = state_names(terms)
+    names = state_names(terms, added)
     values = {k: v for k, v in globals().items() if k.isupper() and type(v) is int}
-    for name, _ in STATES:
+    for name, _ in every_state(added):
         values[f"Y_{name}"] = names.index(name) if name in names else -1
     values["NY"] = len(names)
     for symbol in TERMS:
         values[f"ON_{symbol}"] = int(symbol in terms)
-    values["ON_X"] = int(added)
+    for info in added:
+        if info.terms:  # a force alone gets its columns in ``_added_force``'s call
+            values.update(added_names(info))
+    values["ON_X"] = int(any(info.weight_force is not None for info in added))
     # The most fibre segments the set has: the pulley's rim splits the fibre in two.
     values["SEGMENTS"] = 2 if "PI" in terms else 1
-    values["ON_ANY"] = int(bool(terms) or added)
+    values["ON_ANY"] = int(bool(terms) or bool(added))
     return values

@@ -108,7 +108,7 @@ def parameter_row(stand: StandParams, effects: Sequence[EffectSpec] = ()) -> Flo
         if info.check_stand is not None:
             info.check_stand(stand)
         row[info.flag_column] = 1.0
-        if info.weight_force is not None:
+        if info.added:
             row[layout.R_X_ON] = 1.0
         values = spec.resolved()
         for p in info.params:
@@ -119,17 +119,15 @@ def parameter_row(stand: StandParams, effects: Sequence[EffectSpec] = ()) -> Flo
 def _kernel(rows: FloatArray) -> ModuleType:
     """The compiled model for these rows: the baseline unless one has a physical effect on.
 
-    With one, the union of the built-in terms, composed with the forces of the added
-    effects any row has on.
+    With one, the union of the built-in terms, composed with the added effects (forces,
+    terms) that any row has on.
     """
     rows2 = np.atleast_2d(rows)
     physical = [info.flag_column for info in EFFECTS.values() if info.kind == "physical"]
     if not np.any(rows2[:, physical] > 0):
         return compose.baseline()
     added = tuple(
-        info
-        for info in EFFECTS.values()
-        if info.weight_force is not None and np.any(rows2[:, info.flag_column] > 0)
+        info for info in EFFECTS.values() if info.added and np.any(rows2[:, info.flag_column] > 0)
     )
     return compose.kernel_for(layout.TERMS, added)
 

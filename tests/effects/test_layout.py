@@ -34,7 +34,7 @@ def test_reading_the_effects_and_their_columns_loads_no_numba() -> None:
 def test_the_row_follows_the_registry_order_effect_by_effect() -> None:
     expected = layout.STAND_COLUMNS
     for info in EFFECTS.values():
-        if info.weight_force is not None:
+        if info.added:
             continue  # added with register: in the block from R_X
         assert info.flag_column == expected
         assert [p.column for p in info.params] == list(
@@ -47,7 +47,7 @@ def test_the_row_follows_the_registry_order_effect_by_effect() -> None:
     assert expected == layout.R_X_ON
     assert layout.N_ROW == layout.R_X + layout.N_X
     # The constants array continues where the row ends, nothing numbered twice.
-    after = sorted(v for k, v in layout.constants((), False).items() if k[:2] in ("D_", "S_", "E_"))
+    after = sorted(v for k, v in layout.constants(()).items() if k[:2] in ("D_", "S_", "E_"))
     assert after[0] == layout.N_ROW
     assert len(set(after)) == len(after)
     assert max(after) < layout.C_TABLE
@@ -58,8 +58,8 @@ def test_the_unions_state_names_follow_the_state_table() -> None:
     assert [getattr(layout, f"Y_{name}") for name in names] == list(range(len(names)))
     assert len(names) == layout.NY
     assert set(layout.CARRIED) <= set(names)
-    assert layout.constants(layout.TERMS, False)["NY"] == len(names)
-    assert layout.constants((), False)["Y_Z"] == -1  # the baseline has no bristle
+    assert layout.constants(layout.TERMS)["NY"] == len(names)
+    assert layout.constants(())["Y_Z"] == -1  # the baseline has no bristle
 
 
 def test_the_heads_own_blocks_are_what_compose_writes_for_the_union() -> None:
