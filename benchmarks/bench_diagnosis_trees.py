@@ -1,0 +1,105 @@
+"""Benchmark: a 4-recording diagnosis in two source trees, side by side (issue 32).
+
+    git archive b677bbe | tar -x -C /tmp/before     # main before the refactor
+    .venv/bin/python benchmarks/bench_diagnosis_trees.py --before /tmp/before [--rounds 2]
+
+Each campaign (a same-form truth at a weight, seed 1, the four moderate recordings) is
+diagnosed in a fresh process per tree, in turns (before, now, before, now), so that this
+machine's load falls on both alike. In each process the campaign is diagnosed twice and
+the second is timed (the first loads numba's caches). This tree's "how sure" stage
+(intervals and per-recording fits, added after the refactor) is left out so that both
+trees do the same work. Printed: per campaign, the best wall and process CPU time (user
++ sys, all threads) of the rounds, and whether both trees named the same effects.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent.parent
+CAMPAIGNS = (("none", 3.096), ("fibre_viscoelastic", 8.131), ("stick_slip_friction", 3.096))
+EMPTY_SURE = {"baseline_intervals": {}, "baseline_reaches_bound": [], "gap_closure_interval": None,
+              "gap_intervals": {}, "interval_method": "", "per_recording": {}, "consistency": {},
+              "baseline_consistency": {}}  # fmt: skip
+
+
+def measure(truth: str, mass: float) -> dict[str, object]:
+    """Diagnose the campaign twice in this process (its tree on sys.path); time the second."""
+    import importlib
+
+    try:
+        check = importlib.import_module("sim.checks.check")
+        pipeline = importlib.import_module("sim.identify.pipeline")
+        pipeline.how_sure = lambda *_a, **_k: dict(EMPTY_SURE)  # type: ignore[attr-defined]
+    except ImportError:  # the tree before the refactor
+        check = importlib.import_module("sim.identify.check")
+    from sim.config import load_config
+    from sim.identify import diagnose
+
+    stand = load_config(None)
+    spec = check.CaseSpec(truth, mass, 0, 1)
+    traces, _, _ = check.make_campaign(stand, truth, mass, spec.rng(),
+                                       check.recording_set("moderate", stand))  # fmt: skip
+    nominal = stand.stand_params("final", mass)
+    diagnose(traces, nominal)
+    wall, cpu = time.perf_counter(), time.process_time()
+    d = diagnose(traces, nominal)
+    return {"wall": time.perf_counter() - wall, "cpu": time.process_time() - cpu,
+            "named": sorted(a.effect for a in d.effects)}  # fmt: skip
+
+
+def child(tree: Path, truth: str, mass: float) -> dict[str, object]:
+    env = {**os.environ, "PYTHONPATH": str(tree)}
+    argv = [sys.executable, __file__, "--child", truth, str(mass)]
+    done = subprocess.run(argv, env=env, cwd=tree, capture_output=True, text=True, check=False)
+    if done.returncode != 0:
+        raise SystemExit(f"{tree}: {done.stderr.strip().splitlines()[-1]}")
+    return json.loads(done.stdout.strip().splitlines()[-1])  # type: ignore[no-any-return]
+
+
+def main() -> None:
+    if len(sys.argv) == 4 and sys.argv[1] == "--child":
+        print(json.dumps(measure(sys.argv[2], float(sys.argv[3]))))
+        return
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--before", type=Path, required=True, help="the other source tree")
+    parser.add_argument("--rounds", type=int, default=2)
+    args = parser.parse_args()
+    trees = {"before": args.before.resolve(), "now": HERE}
+    best: dict[tuple[str, str], dict[str, object]] = {}
+    for r in range(args.rounds):
+        for truth, mass in CAMPAIGNS:
+            for label, tree in trees.items():
+                got = child(tree, truth, mass)
+                key = (f"{truth} {mass:g} kg", label)
+                old = best.get(key)
+                best[key] = (
+                    got
+                    if old is None
+                    else {
+                        **got,
+                        "wall": min(got["wall"], old["wall"]),  # type: ignore[type-var]
+                        "cpu": min(got["cpu"], old["cpu"]),  # type: ignore[type-var]
+                    }
+                )
+                print(f"round {r + 1} {key[0]} {label}: {got['wall']:.1f} s wall, "
+                      f"{got['cpu']:.1f} s CPU, named {got['named']}", flush=True)  # fmt: skip
+    print("| campaign | wall, before | wall, now | CPU, before | CPU, now | same answer |")
+    print("|---|---|---|---|---|---|")
+    for truth, mass in CAMPAIGNS:
+        name = f"{truth} {mass:g} kg"
+        b, n = best[(name, "before")], best[(name, "now")]
+        print(
+            f"| {name} | {b['wall']:.1f} s | {n['wall']:.1f} s | {b['cpu']:.1f} s | "
+            f"{n['cpu']:.1f} s | {'yes' if b['named'] == n['named'] else 'NO'} |"
+        )
+
+
+if __name__ == "__main__":
+    main()
