@@ -326,12 +326,7 @@ def diagnose_case(
         # no evidence of an effect, ``none`` is what the recordings show.
         identifiable = compare(traces, d.outputs_before, oracle).accepted(tests=1)
     kinds = tuple(s.kind for s in d.remainder.signature if s.passes) if d.remainder else ()
-    trends = {
-        k: "+".join([v["moves_with"], *v.get("also_with", [])])
-        for k, v in d.baseline_consistency.items()
-        if v["moves_with"]
-    }
-    pointers = {k: v["points_to"] for k, v in d.baseline_consistency.items() if v["points_to"]}
+    trends, pointers = summaries.baseline_trends(d)
     case = Case(
         spec.truth, spec.mass_kg, d.effect, params, shrink, oracle_shrink, seconds, identifiable,
         d.verdict, named_effects(d), kinds,

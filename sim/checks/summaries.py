@@ -88,6 +88,20 @@ def trend_summary(cases: Sequence[Case]) -> dict[str, dict[str, float]]:
     }
 
 
+def baseline_trends(d: Diagnosis) -> tuple[dict[str, str], dict[str, str]]:
+    """The baseline alone's per-recording trends: what each scale moved with, what it points to.
+
+    Covariates are joined by ``+`` where the recordings cannot tell them apart.
+    """
+    trends = {
+        k: "+".join([v["moves_with"], *v.get("also_with", [])])
+        for k, v in d.baseline_consistency.items()
+        if v["moves_with"]
+    }
+    pointers = {k: v["points_to"] for k, v in d.baseline_consistency.items() if v["points_to"]}
+    return trends, pointers
+
+
 def covered_truth(d: Diagnosis, effect: str, truth: dict[str, float]) -> dict[str, bool]:
     """Whether each interval the diagnosis gives holds the true value (where it is known).
 
