@@ -10,6 +10,10 @@ the second is timed (the first loads numba's caches). This tree's "how sure" sta
 (intervals and per-recording fits, added after the refactor) is left out so that both
 trees do the same work. Printed: per campaign, the best wall and process CPU time (user
 + sys, all threads) of the rounds, and whether both trees named the same effects.
+
+``--objective``: what a diagnosis spends its time on, alone: the training objective of
+each campaign's candidate (its own effect; the baseline for ``none``) evaluated for a
+batch of 8 parameter sets, best CPU time of 7, one numba thread, in each tree.
 """
 
 from __future__ import annotations
@@ -54,9 +58,46 @@ def measure(truth: str, mass: float) -> dict[str, object]:
             "named": sorted(a.effect for a in d.effects)}  # fmt: skip
 
 
-def child(tree: Path, truth: str, mass: float) -> dict[str, object]:
-    env = {**os.environ, "PYTHONPATH": str(tree)}
-    argv = [sys.executable, __file__, "--child", truth, str(mass)]
+def objective(truth: str, mass: float) -> dict[str, object]:
+    """Best CPU time of the candidate's objective over a batch of 8 sets (this tree)."""
+    import dataclasses
+    import importlib
+
+    import numpy as np
+
+    try:
+        check = importlib.import_module("sim.checks.check")
+    except ImportError:  # the tree before the refactor
+        check = importlib.import_module("sim.identify.check")
+    from sim.config import load_config
+    from sim.identify.fitting import Candidate, Objective
+    from sim.identify.shooting import dial_slope
+
+    stand = load_config(None)
+    spec = check.CaseSpec(truth, mass, 0, 1)
+    traces, _, _ = check.make_campaign(stand, truth, mass, spec.rng(),
+                                       check.recording_set("moderate", stand))  # fmt: skip
+    slope = dial_slope(traces)
+    traces = [dataclasses.replace(tr, dial_slope=slope) for tr in traces]
+    cand = Candidate.build() if truth == "none" else Candidate.build(truth)
+    obj = Objective(cand, traces, stand.stand_params("final", mass), 4)
+    middle = {p.name: 0.5 * (p.low + p.high) for p in cand.params}
+    z = cand.internal({**middle, "stiffness_scale": 1.0, "damping_scale": 1.0})
+    zs = np.stack([z] * 8)
+    obj.residuals_batch(zs)
+    times = []
+    for _ in range(7):
+        cpu = time.process_time()
+        obj.residuals_batch(zs)
+        times.append(time.process_time() - cpu)
+    return {"wall": min(times), "cpu": min(times), "named": []}
+
+
+def child(tree: Path, truth: str, mass: float, mode: str = "--child") -> dict[str, object]:
+    env = {**os.environ, "PYTHONPATH": str(tree), "NUMBA_NUM_THREADS": "1"}
+    if mode == "--child":
+        env.pop("NUMBA_NUM_THREADS")
+    argv = [sys.executable, __file__, mode, truth, str(mass)]
     done = subprocess.run(argv, env=env, cwd=tree, capture_output=True, text=True, check=False)
     if done.returncode != 0:
         raise SystemExit(f"{tree}: {done.stderr.strip().splitlines()[-1]}")
@@ -64,19 +105,27 @@ def child(tree: Path, truth: str, mass: float) -> dict[str, object]:
 
 
 def main() -> None:
-    if len(sys.argv) == 4 and sys.argv[1] == "--child":
-        print(json.dumps(measure(sys.argv[2], float(sys.argv[3]))))
+    if len(sys.argv) == 4 and sys.argv[1] in ("--child", "--objective-child"):
+        work = measure if sys.argv[1] == "--child" else objective
+        print(json.dumps(work(sys.argv[2], float(sys.argv[3]))))
         return
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--before", type=Path, required=True, help="the other source tree")
     parser.add_argument("--rounds", type=int, default=2)
+    parser.add_argument("--objective", action="store_true", help="time the objective alone")
     args = parser.parse_args()
+    mode = "--objective-child" if args.objective else "--child"
+
+    def fmt(seconds: object) -> str:
+        value = float(seconds)  # type: ignore[arg-type]
+        return f"{value * 1e3:.1f} ms" if args.objective else f"{value:.1f} s"
+
     trees = {"before": args.before.resolve(), "now": HERE}
     best: dict[tuple[str, str], dict[str, object]] = {}
     for r in range(args.rounds):
         for truth, mass in CAMPAIGNS:
             for label, tree in trees.items():
-                got = child(tree, truth, mass)
+                got = child(tree, truth, mass, mode)
                 key = (f"{truth} {mass:g} kg", label)
                 old = best.get(key)
                 best[key] = (
@@ -88,16 +137,16 @@ def main() -> None:
                         "cpu": min(got["cpu"], old["cpu"]),  # type: ignore[type-var]
                     }
                 )
-                print(f"round {r + 1} {key[0]} {label}: {got['wall']:.1f} s wall, "
-                      f"{got['cpu']:.1f} s CPU, named {got['named']}", flush=True)  # fmt: skip
+                print(f"round {r + 1} {key[0]} {label}: {fmt(got['wall'])} wall, "
+                      f"{fmt(got['cpu'])} CPU, named {got['named']}", flush=True)  # fmt: skip
     print("| campaign | wall, before | wall, now | CPU, before | CPU, now | same answer |")
     print("|---|---|---|---|---|---|")
     for truth, mass in CAMPAIGNS:
         name = f"{truth} {mass:g} kg"
         b, n = best[(name, "before")], best[(name, "now")]
         print(
-            f"| {name} | {b['wall']:.1f} s | {n['wall']:.1f} s | {b['cpu']:.1f} s | "
-            f"{n['cpu']:.1f} s | {'yes' if b['named'] == n['named'] else 'NO'} |"
+            f"| {name} | {fmt(b['wall'])} | {fmt(n['wall'])} | {fmt(b['cpu'])} | "
+            f"{fmt(n['cpu'])} | {'yes' if b['named'] == n['named'] else 'NO'} |"
         )
 
 
