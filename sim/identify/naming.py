@@ -203,10 +203,10 @@ def further_effect(
     for effect in tries:
         say(f"refitting {effect} on top of {first}")
         probe = [probes[effect]] if effect in probes else []
-        probe += data_starts(effect, traces, nominal, current.result.values)
         probe += [alone[effect]] if effect in alone else []
+        shown = data_starts(effect, traces, nominal, current.result.values)
         fits[effect] = refit(
-            Candidate.build(*named, effect), traces, nominal, current.result.values, probe
+            Candidate.build(*named, effect), traces, nominal, current.result.values, probe, shown
         )
         sims += fits[effect].result.evaluations
     evidence = judge(traces, current.outputs, {e: f.outputs for e, f in fits.items()})

@@ -217,9 +217,9 @@ def _refit_all(
             run.say(f"refitting {effect} (screening score {scores[effect]:.3f})")
             with run.timed(f"refit {effect}"):
                 probe = [probes[effect]] if effect in probes else []
-                probe += data_starts(effect, run.traces, run.nominal, base_values)
+                shown = data_starts(effect, run.traces, run.nominal, base_values)
                 refits[effect] = refit(
-                    Candidate.build(effect), run.traces, run.nominal, base_values, probe
+                    Candidate.build(effect), run.traces, run.nominal, base_values, probe, shown
                 )
             run.simulations += refits[effect].result.evaluations
         leader = min(refits, key=lambda e: refits[e].result.train_cost, default=None)
