@@ -36,18 +36,22 @@ def record(
     rows: FloatArray,
     gauge0: FloatArray | None = None,
     first: IntArray | None = None,
+    runs_per_row: int = 1,
 ) -> tuple[FloatArray, FloatArray]:
-    """Recorded u (m) and F (N) of runs (sets, samples) with these kernel rows.
+    """Recorded u (m) and F (N) of runs (runs, samples) with these kernel rows.
 
     ``gauge0`` (sets, 2): the force gauge's output and its rate at each run's first
     sample (NaN, or None for all: settled on the run's first force, a run from rest);
     ``first`` (sets,): each run's first sample in its recording (None: 0), the time
-    base of added gauge effects. Returns ``u`` and ``force`` themselves if no row has a
+    base of added gauge effects; ``runs_per_row``: each row's consecutive runs (a row's
+    segments). Returns ``u`` and ``force`` themselves if no row has a
     gauge effect on (the recorded channels are the true ones).
     """
     sets = u.shape[0]
     mrows = measure.measurement_rows(rows)
     added = _added_on(rows)
+    if runs_per_row > 1:
+        mrows = np.repeat(mrows, runs_per_row, axis=0)
     if not mrows[:, [measure.M_DG_ON, measure.M_FG_ON, measure.M_CS_ON]].any():
         if not added:
             return u, force
@@ -57,7 +61,7 @@ def record(
         settled = np.full((sets, 2), np.nan) if gauge0 is None else gauge0
         measure.measure_batch_into(u, force, 1.0 / rate_hz, mrows, settled, rec_u, rec_f)
     starts = np.zeros(sets, dtype=np.int64) if first is None else first
-    _record_added(added, rows, rate_hz, starts, rec_u, rec_f)
+    _record_added(added, rows, rate_hz, starts, rec_u, rec_f, runs_per_row)
     return rec_u, rec_f
 
 
@@ -81,14 +85,17 @@ def _record_added(
     first: IntArray,
     u: FloatArray,
     force: FloatArray,
+    runs_per_row: int = 1,
 ) -> None:
-    """Apply the added gauge effects, in place, to each row's run that has them on."""
+    """Apply the added gauge effects, in place, to each run whose row has them on."""
     n = u.shape[1]
     for info in added:
         assert info.record is not None
-        for b in np.flatnonzero(rows[:, info.flag_column] > 0):
-            t = (first[b] + np.arange(n)) / rate_hz
-            u[b], force[b] = info.record(_values(info, rows[b]), t, u[b], force[b])
+        for r in np.flatnonzero(rows[:, info.flag_column] > 0):
+            values = _values(info, rows[r])
+            for b in range(r * runs_per_row, (r + 1) * runs_per_row):
+                t = (first[b] + np.arange(n)) / rate_hz
+                u[b], force[b] = info.record(values, t, u[b], force[b])
 
 
 def transform_key(row: FloatArray, on: list[EffectInfo]) -> bytes:

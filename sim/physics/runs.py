@@ -221,8 +221,8 @@ def measure_segments(
     flat_u = np.ascontiguousarray(u.reshape(sets * segs, width))
     flat_f = np.ascontiguousarray(force.reshape(sets * segs, width))
     rec_u, rec_f = gauges.record(
-        flat_u, flat_f, rate_hz, np.repeat(np.atleast_2d(rows), segs, axis=0),
-        gauge0.reshape(sets * segs, 2), np.tile(np.asarray(starts, dtype=np.int64), sets),
+        flat_u, flat_f, rate_hz, np.atleast_2d(rows), gauge0.reshape(sets * segs, 2),
+        np.tile(np.asarray(starts, dtype=np.int64), sets), runs_per_row=segs,
     )  # fmt: skip
     return rec_u.reshape(u.shape), rec_f.reshape(force.shape)
 
