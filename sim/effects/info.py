@@ -34,8 +34,10 @@ IntArray = NDArray[np.int64]
 __all__ = [
     "EffectError",
     "EffectInfo",
+    "InvertGauge",
     "Measured",
     "ParamInfo",
+    "RecordGauge",
     "StartState",
     "TrueChannels",
     "param",
@@ -71,6 +73,17 @@ StartState = Callable[[FloatArray, Measured, IntArray, FloatArray], None]
 #: on the model's scale from the recorded ones.
 TrueChannels = Callable[
     [FloatArray, float, FloatArray, FloatArray, FloatArray],
+    tuple[FloatArray, FloatArray, FloatArray],
+]
+#: An added gauge effect's transform: ``record(values, t_s, u, force)`` → (u, force) as
+#: recorded, with ``values`` its parameters in order and ``t_s`` each sample's time from
+#: the recording's start (memoryless: a sample's reading depends on that sample alone).
+RecordGauge = Callable[
+    [FloatArray, FloatArray, FloatArray, FloatArray], tuple[FloatArray, FloatArray]
+]
+#: Its inverse: ``invert(values, t_s, u, v, force)`` → (u, v, force) from the recorded ones.
+InvertGauge = Callable[
+    [FloatArray, FloatArray, FloatArray, FloatArray, FloatArray],
     tuple[FloatArray, FloatArray, FloatArray],
 ]
 
@@ -175,6 +188,12 @@ class EffectInfo:
     #: of ``sim.physics.kernel_source``) and helpers ``_<symbol>_…`` the model composes in,
     #: as it does the built-in terms (``sim.physics.added``). None: none.
     terms: str | None = None
+    #: A gauge effect added outside (kind "measurement"): what its gauge records
+    #: (``RecordGauge``), applied after the built-in gauge chain (``sim.physics.gauges``).
+    record: RecordGauge | None = None
+    #: Its inverse (``InvertGauge``), for segment restarts from recorded channels; None:
+    #: the restarts take the recorded channels as the true ones.
+    invert: InvertGauge | None = None
     #: Its continuous states (``terms``): appended after the built-in ones, named
     #: ``Y_<symbol>_<state>`` in its hooks; their values at rest, rates and values at a
     #: measured start come from its ``rest``, ``rates`` and ``start_state`` hooks.
@@ -207,7 +226,12 @@ class EffectInfo:
 
     @property
     def added(self) -> bool:
-        """Added outside the kernel with ``register`` (a compiled force or terms of its own)."""
+        """Added with ``register`` (a compiled force, terms of its own, or a gauge transform)."""
+        return self.weight_force is not None or self.terms is not None or self.record is not None
+
+    @property
+    def composed(self) -> bool:
+        """Added with physics of its own: composed into the compiled model."""
         return self.weight_force is not None or self.terms is not None
 
     def param(self, name: str) -> ParamInfo:

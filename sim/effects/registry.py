@@ -118,7 +118,8 @@ def register(info: EffectInfo) -> EffectInfo:
     """Add an effect defined outside the kernel (a tenth one): its own module, one call.
 
     The effect brings a compiled ``weight_force``, or terms of its own (``terms``: its
-    hooks, with its continuous ``states`` and its discrete ``slots``), or both (see
+    hooks, with its continuous ``states`` and its discrete ``slots``), or both; or, a
+    gauge effect, what its gauge records (``record``, and ``invert`` for restarts: see
     ``EffectInfo`` and docs/architecture.md); ``sim.physics.added.check`` refuses what the
     model cannot compose. Its flag and parameters get the next free columns of the kernel
     row's extension block, its slots the next of the constants' (the columns and slot

@@ -5,8 +5,8 @@
 states, and ``Stream`` advances block by block for the simulated stand. Every run goes
 through one compiled model (``sim.physics.compose``): without physical effects the
 empty set of terms (the baseline), with them the built-in union (composed with the
-forces of effects added by ``register``); measurement effects then act on the outputs
-(``sim.effects.measure``).
+forces and terms of effects added by ``register``); gauge effects then act on the
+outputs, in one chain (``sim.physics.gauges``).
 """
 
 from __future__ import annotations
@@ -18,11 +18,10 @@ from types import ModuleType
 import numpy as np
 from numpy.typing import NDArray
 
-from sim.effects import measure
 from sim.effects.registry import EFFECTS, EffectError, EffectSpec, check_unique, effect_info
 from sim.errors import SimulationError
 from sim.params import FrictionTable, StandParams
-from sim.physics import compose, layout
+from sim.physics import compose, gauges, layout
 from sim.results import BatchResult, ModelRun
 
 FloatArray = NDArray[np.float64]
@@ -108,7 +107,7 @@ def parameter_row(stand: StandParams, effects: Sequence[EffectSpec] = ()) -> Flo
         if info.check_stand is not None:
             info.check_stand(stand)
         row[info.flag_column] = 1.0
-        if info.added:
+        if info.composed:  # an added gauge effect leaves the dynamics alone
             row[layout.R_X_ON] = 1.0
         values = spec.resolved()
         for p in info.params:
@@ -127,22 +126,11 @@ def _kernel(rows: FloatArray) -> ModuleType:
     if not np.any(rows2[:, physical] > 0):
         return compose.baseline()
     added = tuple(
-        info for info in EFFECTS.values() if info.added and np.any(rows2[:, info.flag_column] > 0)
+        info
+        for info in EFFECTS.values()
+        if info.composed and np.any(rows2[:, info.flag_column] > 0)
     )
     return compose.kernel_for(layout.TERMS, added)
-
-
-def _measure_run(
-    u: FloatArray, t1: FloatArray, dt: float, row: FloatArray
-) -> tuple[FloatArray, FloatArray]:
-    out_u, out_f = np.empty_like(u), np.empty_like(t1)
-    measure.measure_into(u, t1, dt, measure.measurement_rows(row)[0], _settled(1)[0], out_u, out_f)
-    return out_u, out_f
-
-
-def _settled(runs: int) -> FloatArray:
-    """``measure``'s gauge0 for runs from rest: the force gauge settled on the first force."""
-    return np.full((runs, 2), np.nan)
 
 
 def simulate(
@@ -173,7 +161,8 @@ def simulate(
     knots, coef = friction_arrays(stand.friction)
     u, v, t1, t2 = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
     most = _kernel(row).simulate_into(x, 1.0 / rate_hz, substeps, row, knots, coef, u, v, t1, t2)
-    rec_u, rec_f = _measure_run(u, t1, 1.0 / rate_hz, row)
+    rec_u, rec_f = gauges.record(u[None, :], t1[None, :], rate_hz, row[None, :])
+    rec_u, rec_f = rec_u[0].copy(), rec_f[0].copy()  # apart from the true channels
     t = np.arange(n) / rate_hz
     x_out = np.asarray(x_m, dtype=np.float64)
     t0 = stand.preload_tension_n
@@ -206,17 +195,8 @@ def simulate_rows(
     dt = 1.0 / rate_hz
     kernel.simulate_batch_into(x2, dt, substeps, rows2, knots, coef, u, v, t1, t2)
     t = np.arange(n) / rate_hz
-    mrows = measure.measurement_rows(rows2)
-    if not _gauged(mrows):
-        return BatchResult(t, u, v, t1, u, t1)  # no gauge effect: recorded = true
-    rec_u, rec_f = np.empty_like(u), np.empty_like(t1)
-    measure.measure_batch_into(u, t1, dt, mrows, _settled(sets), rec_u, rec_f)
+    rec_u, rec_f = gauges.record(u, t1, rate_hz, rows2)  # u, t1 themselves if no gauge is on
     return BatchResult(t, rec_u, v, rec_f, u, t1)
-
-
-def _gauged(mrows: FloatArray) -> bool:
-    """Whether any measurement row has a gauge effect on (else the channels are the true)."""
-    return bool(mrows[:, [measure.M_DG_ON, measure.M_FG_ON, measure.M_CS_ON]].any())
 
 
 def measure_segments(
@@ -236,18 +216,14 @@ def measure_segments(
     the warm-up, and the true model's restarts cost 25× the open-loop error.
     """
     sets, segs, width = u.shape
-    mrows = measure.measurement_rows(rows)
-    if not _gauged(mrows):
-        return u, force  # no gauge effect: the recorded channels are the true ones
-    m = np.repeat(mrows, segs, axis=0)
     gauge0 = np.ascontiguousarray(init[:, :, [layout.I_F, layout.I_FRATE]], dtype=np.float64)
     gauge0[:, starts == 0, :] = np.nan
     flat_u = np.ascontiguousarray(u.reshape(sets * segs, width))
     flat_f = np.ascontiguousarray(force.reshape(sets * segs, width))
-    rec_u, rec_f = np.empty_like(flat_u), np.empty_like(flat_f)
-    measure.measure_batch_into(
-        flat_u, flat_f, 1.0 / rate_hz, m, gauge0.reshape(sets * segs, 2), rec_u, rec_f
-    )
+    rec_u, rec_f = gauges.record(
+        flat_u, flat_f, rate_hz, np.atleast_2d(rows), gauge0.reshape(sets * segs, 2),
+        np.tile(np.asarray(starts, dtype=np.int64), sets), runs_per_row=segs,
+    )  # fmt: skip
     return rec_u.reshape(u.shape), rec_f.reshape(force.shape)
 
 
@@ -321,10 +297,6 @@ class Stream:
         self.rate_hz = rate_hz
         self.effects = tuple(effects)
         self._row = parameter_row(stand, effects)
-        self._m = measure.measurement_rows(self._row)[0]
-        self._skews = (self._m[measure.M_SKEW_U], self._m[measure.M_SKEW_F])
-        if self._m[measure.M_CS_ON] > 0 and min(self._skews) < 0:
-            raise EffectError("a stream cannot record a channel early (negative skew)")
         knots, coef = friction_arrays(stand.friction)
         self._kernel = _kernel(self._row)
         self._c = self._kernel.pack(self._row, knots, coef)
@@ -333,11 +305,7 @@ class Stream:
         self._x0 = x0_m
         self._last_x = x0_m
         t0 = self._c[layout.D_K1] * self._c[layout.D_D10]  # the force at sample 0, as simulate_into
-        self._gauge = np.array([t0, 0.0, t0])  # filter state (y, ẏ, previous input)
-        u_rest = self._m[measure.M_OFFSET] if self._m[measure.M_DG_ON] > 0 else 0.0
-        depth = int(np.ceil(max(self._skews) * rate_hz)) + 2
-        self._hist_u = np.full(depth, u_rest)
-        self._hist_f = np.full(depth, t0)
+        self._measure = gauges.GaugeStream(self._row, rate_hz, t0)
 
     @property
     def velocity_m_s(self) -> float:
@@ -359,28 +327,4 @@ class Stream:
         self._kernel.advance_into(x, dt, self._substeps, self._c, self._y, u, v, t1, t2)
         if n:
             self._last_x = float(block[-1])
-        return self._measure(u[1:], t1[1:], dt)
-
-    def _measure(
-        self, u: FloatArray, force: FloatArray, dt: float
-    ) -> tuple[FloatArray, FloatArray]:
-        m = self._m
-        gu = (1.0 + m[measure.M_GAIN]) * u + m[measure.M_OFFSET] if m[measure.M_DG_ON] > 0 else u
-        gf = force.copy()
-        if m[measure.M_FG_ON] > 0:
-            measure.gauge_filter_into(
-                force, dt, m[measure.M_FC], m[measure.M_ZETA], self._gauge, gf
-            )
-        if m[measure.M_CS_ON] <= 0:
-            return gu, gf
-        out = []
-        for hist, series, skew in (
-            (self._hist_u, gu, self._skews[0]),
-            (self._hist_f, gf, self._skews[1]),
-        ):
-            ext = np.concatenate([hist, series])
-            rec = np.empty(series.shape[0])
-            measure.skew_into(ext, hist.shape[0], skew / dt, rec)
-            hist[:] = ext[ext.shape[0] - hist.shape[0] :]
-            out.append(rec)
-        return out[0], out[1]
+        return self._measure(u[1:], t1[1:])

@@ -5,10 +5,11 @@ the dial gauge reads is scaled by its gain G against the drive encoder, which th
 recording itself shows (``Restarts.dial_slope``): every row restarts from u_rec/G, so a
 gain error never becomes a wrong elongation (a wrong force) — it stays in the u channel,
 where a candidate's dial gauge model maps the true u to the reading. Gauge effects with
-an inverse (``EffectInfo.true_channels``: a skewed channel) map the recorded channels to
-the true ones first; effects with measurable states set them (``EffectInfo.start_state``:
-the Maxwell branch, the pulley seat). The other effects' states are set inside the
-kernel (``kernel.measured_state``) or carried between segments.
+an inverse (``EffectInfo.true_channels``: a skewed channel; ``EffectInfo.invert``: one
+added with ``register``) map the recorded channels to the true ones first
+(``sim.physics.gauges.true_channels``); effects with measurable states set them
+(``EffectInfo.start_state``: the Maxwell branch, the pulley seat). The other effects'
+states are set inside the kernel (``kernel.measured_state``) or carried between segments.
 """
 
 from __future__ import annotations
@@ -19,9 +20,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sim.effects.fibre_pulley_jump import recorded_seat
-from sim.effects.info import EffectInfo, Measured
+from sim.effects.info import Measured
 from sim.effects.registry import EFFECTS
-from sim.physics import layout
+from sim.physics import gauges, layout
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -64,9 +65,9 @@ def start_states(
     channels: dict[bytes, tuple[FloatArray, FloatArray, FloatArray, FloatArray]] = {}
     for b, row in enumerate(rows2):
         on = [info for info in EFFECTS.values() if row[info.flag_column] > 0]
-        key = _transform_key(row, on)
+        key = gauges.transform_key(row, on)
         if key not in channels:
-            u, v, force = _true_channels(row, on, rate_hz, u_m, v_m_s, force_n, dial_slope)
+            u, v, force = gauges.true_channels(row, on, rate_hz, u_m, v_m_s, force_n, dial_slope)
             channels[key] = (u, v, force, np.gradient(force, 1.0 / rate_hz)[starts])
         u, v, force, rate = channels[key]
         init[b, :, layout.I_U] = u[starts]
@@ -80,35 +81,3 @@ def start_states(
         if jumps[b]:
             seats[b] = recorded_seat(row, measured)
     return StartStates(init, seats)
-
-
-def _transform_key(row: FloatArray, on: list[EffectInfo]) -> bytes:
-    """What ``_true_channels`` depends on in a row.
-
-    The gauge's scale and, for each effect with an inverse, its flag and parameters.
-    """
-    parts = [row[layout.P_PROJ]]
-    for info in on:
-        if info.true_channels is not None:
-            parts += [float(info.flag_column)] + [row[p.column] for p in info.params]
-    return np.asarray(parts, dtype=np.float64).tobytes()
-
-
-def _true_channels(
-    row: FloatArray,
-    on: list[EffectInfo],
-    rate_hz: float,
-    u_m: FloatArray,
-    v_m_s: FloatArray,
-    force_n: FloatArray,
-    dial_slope: float,
-) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """The weight's u and v on the model's scale and the force, from the recorded ones."""
-    u, v, force = u_m, v_m_s, force_n
-    for info in on:
-        if info.true_channels is not None:
-            u, v, force = info.true_channels(row, rate_hz, u, v, force)
-    if np.isfinite(dial_slope) and dial_slope > 0:
-        scale = dial_slope * row[layout.P_PROJ]
-        u, v = u / scale, v / scale
-    return u, v, force
