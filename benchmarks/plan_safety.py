@@ -9,7 +9,7 @@ them (k ×0.8–1.25, c ×0.7–1.4, friction ×0.8–1.25), each with one of th
 physical effects drawn at random (or none), and checked against the limits: the slack
 e-stop (recorded F < 2 N for > 0.25 s), the weight's travel and the fibre's safe peak
 tension. Prints the counts and every violation, and which of them the planner could plan
-(its set: within ``PLAN_MARGIN`` of every limit, slack at most ``PREDICTABLE_SLACK``).
+(its set, ``sim.planner.plannable``: ``PLAN_MARGIN`` inside every limit).
 
 Run: ``.venv/bin/python benchmarks/plan_safety.py [--draws N]``.
 """
@@ -25,7 +25,7 @@ from sim.checks.otherstand import OTHER_EFFECTS, simulate
 from sim.checks.otherstand.campaign import draw_true_stand
 from sim.config import default_config
 from sim.envelope import NOMINAL_SPREAD, SlackRule, figures_of
-from sim.planner import PLAN_MARGIN, PREDICTABLE_SLACK, motion_grid
+from sim.planner import motion_grid, plannable
 from sim.prediction import predict
 
 RULE = SlackRule(2.0, 0.25)
@@ -49,9 +49,8 @@ def main() -> None:
         if p.breaches(config.envelope, RULE):
             continue
         admitted += 1
-        margin = min(p.margins(config.envelope, RULE).values())
-        plannable = margin >= PLAN_MARGIN and p.worst.slack_share <= PREDICTABLE_SLACK
-        planned += plannable
+        in_set = plannable(p, config.envelope, RULE)
+        planned += in_set
         rng = np.random.default_rng(i)
         for draw in range(args.draws):
             truth = draw_true_stand(stand, rng)
@@ -75,9 +74,9 @@ def main() -> None:
                 if bad
             ]
             if broken:
-                planned_broken += plannable
+                planned_broken += in_set
                 violations.append(
-                    ("planner's set, " if plannable else "")
+                    ("planner's set, " if in_set else "")
                     + f"{c.describe()} ({', '.join(effects) or 'no effect'}): {', '.join(broken)}"
                     f" (slack {f.longest_slack_s:.2f} s, travel {f.weight_travel_m * 1e3:.0f}"
                     f" mm, peak {f.peak_tension_n:.0f} N)"
