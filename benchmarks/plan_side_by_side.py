@@ -2,19 +2,22 @@
 
 Campaigns of the other truth stand (``sim.checks.otherstand``: its own integrator and
 effect forms, a true stand drawn off nominal, one effect at drawn parameters) recorded
-on a starting set (``--recordings``, default the other stand's ``small`` pair), at
-each weight in turn. The first diagnosis is *ambiguous* when its named effect has a rival
-it cannot tell apart (``indistinguishable_from``) or its answer is wrong (the truth not
-named first; for ``none`` an effect named; for an effect outside the catalogue anything
-but ``unexplained``). Each ambiguous campaign gets one more recording twice, side by
-side on the same true stand: the motion ``labstand plan`` chooses (``plan_motion_for``,
-both weights), and one drawn at random among the motions the same search admitted (the
-same count: one each). Each is diagnosed again with the starting recordings. Right: the
-truth named first (or the right verdict); settled: right with no rival left beside it.
+on a starting set (``--recordings``, default the other stand's ``gentle`` three: small
+strokes, the fibre never slack, a lab sparing its fibre, where six of the nine truths
+barely show), at each weight in turn. The first diagnosis is *ambiguous* when its named
+effect has a rival it cannot tell apart (``indistinguishable_from``) or its answer is
+wrong (the truth not named first; for ``none`` an effect named; for an effect outside
+the catalogue anything but ``unexplained``). Each ambiguous campaign gets one more
+recording twice, side by side on the same true stand: the motion ``labstand plan``
+chooses (``plan_motion_for``, both weights), and one drawn at random among the motions
+the same search admitted (the same count: one each), each run as long as a plan runs
+(``sim.motions.PLAN_S``). Each is diagnosed again with the starting recordings. Right:
+the truth named first (or the right verdict); settled: right with no rival left beside it.
 
 Campaigns run in a process pool (``--jobs``); each finished one is appended to
 ``--out`` as one JSON line at once, and a rerun with the same ``--out`` skips campaigns
-already there. ``--summary FILE`` prints the counts of a results file.
+already there (``--only``: just these campaign numbers). ``--summary FILE`` prints the
+counts of a results file.
 
 Run: ``.venv/bin/python benchmarks/plan_side_by_side.py --campaigns 18 --jobs 1 --out r.jsonl``.
 """
@@ -92,11 +95,12 @@ def campaign(seed: int, k: int, truth: str, mass: float, recordings: str) -> dic
     from labstand.commands.plan import noise_of
     from labstand.errors import CommandError
     from labstand.fitted import fitted_from_dict
-    from labstand.planning import plan_motion_for
+    from labstand.planning import plan_motion_for, setting_for
     from sim.checks.otherstand.campaign import OTHER_SETS, make_other_campaign
     from sim.config import default_config
     from sim.envelope import SlackRule
     from sim.identify.traces import make_trace
+    from sim.planner import as_planned
 
     started = time.perf_counter()
     config = default_config()
@@ -117,6 +121,7 @@ def campaign(seed: int, k: int, truth: str, mass: float, recordings: str) -> dic
         masses = sorted(config.weights_kg.values())
         try:
             answer = plan_motion_for(fitted, config, masses, noise_of(traces), rule, BUDGET_S)
+            setting = setting_for(fitted, config, noise_of(traces), rule)
         except CommandError as err:  # no rivals to separate: counted as no plan
             out["plan"] = {"why": str(err)}
             out["seconds"] = time.perf_counter() - started
@@ -126,6 +131,7 @@ def campaign(seed: int, k: int, truth: str, mass: float, recordings: str) -> dic
                        "admissible": plan.admissible, "complete": plan.complete}  # fmt: skip
         if plan.best is not None:
             drawn = plan.options[int(np.random.default_rng([seed, k, 1]).integers(plan.admissible))]
+            drawn = as_planned(setting, drawn)  # run as long as a plan runs
             for label, choice in (("planned", plan.best), ("random", drawn)):
                 extra = _recorded(camp, choice.spec, choice.mass_kg, label,
                                   np.random.default_rng([seed, k, 2]))  # fmt: skip
@@ -170,7 +176,8 @@ def main() -> None:
     parser.add_argument("--seed", type=int, default=2026)
     parser.add_argument("--truths", default=",".join(CATALOGUE),
                         help="comma-separated: catalogue effects, none, outside ones")  # fmt: skip
-    parser.add_argument("--recordings", default="small", help="the other stand's starting set")
+    parser.add_argument("--recordings", default="gentle", help="the other stand's starting set")
+    parser.add_argument("--only", help="comma-separated campaign numbers (default: all)")
     parser.add_argument("--jobs", type=int, default=1, help="campaigns at once (processes)")
     parser.add_argument("--out", type=Path, default=Path("plan_side_by_side.jsonl"))
     parser.add_argument("--summary", type=Path, help="only print the counts of this file")
@@ -190,6 +197,8 @@ def main() -> None:
          args.recordings)
         for k in range(args.campaigns) if (args.seed, k) not in done
     ]  # fmt: skip
+    if args.only:
+        todo = [job for job in todo if str(job[1]) in args.only.split(",")]
     with (
         ProcessPoolExecutor(args.jobs, mp_context=get_context("spawn")) as pool,
         args.out.open("a") as sink,

@@ -21,9 +21,16 @@ if TYPE_CHECKING:
     from labstand.fitted import FittedStand
     from sim.config import StandConfig
     from sim.envelope import SlackRule
-    from sim.planner import Noise, Plan, Rival
+    from sim.planner import Noise, Plan, Rival, Setting
 
-__all__ = ["PLAN_OPTIONS", "PlanAnswer", "plan_motion_for", "rivals_of", "signal_from_plan"]
+__all__ = [
+    "PLAN_OPTIONS",
+    "PlanAnswer",
+    "plan_motion_for",
+    "rivals_of",
+    "setting_for",
+    "signal_from_plan",
+]
 
 BASELINE = "none"
 #: A separation below this many noise units counts as hardly telling the rivals apart.
@@ -149,19 +156,12 @@ class PlanAnswer:
         return out
 
 
-def plan_motion_for(
-    fitted: FittedStand,
-    config: StandConfig,
-    masses_kg: list[float],
-    noise: Noise,
-    rule: SlackRule,
-    budget_s: float,
-) -> PlanAnswer:
-    """Search the stand's motions for the one that best separates the diagnosis' rivals."""
-    from sim.planner import Setting, motion_grid, search
+def setting_for(fitted: FittedStand, config: StandConfig, noise: Noise, rule: SlackRule) -> Setting:
+    """What the search needs of a diagnosis and a stand (its rivals, model, limits)."""
+    from sim.planner import Setting
 
     rivals, pairs = rivals_of(fitted)
-    setting = Setting(
+    return Setting(
         nominal=config.stand_params("final"),
         spread=fitted.spread(),
         named=fitted.effects,
@@ -173,6 +173,20 @@ def plan_motion_for(
         limits=config.drive,
         rate_hz=config.sample_rate_hz,
     )
+
+
+def plan_motion_for(
+    fitted: FittedStand,
+    config: StandConfig,
+    masses_kg: list[float],
+    noise: Noise,
+    rule: SlackRule,
+    budget_s: float,
+) -> PlanAnswer:
+    """Search the stand's motions for the one that best separates the diagnosis' rivals."""
+    from sim.planner import motion_grid, search
+
+    setting = setting_for(fitted, config, noise, rule)
     plan = search(setting, motion_grid(config.drive, masses_kg), budget_s)
     return PlanAnswer(plan, fitted, config, rule, noise, budget_s)
 

@@ -18,7 +18,6 @@ runs are one batch per motion and rival.
 
 from __future__ import annotations
 
-import itertools
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -26,8 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from drivers.limits import DriveLimits, LimitError
-from drivers.signals import Shape, SignalSpec, plan_motion
+from drivers.limits import DriveLimits
 from sim.discrimination import recording_of, shooting_separation
 from sim.effects.registry import EffectSpec
 from sim.envelope import (
@@ -40,6 +38,7 @@ from sim.envelope import (
     worst_of,
 )
 from sim.model import BatchResult, Model
+from sim.motions import Candidate, lengthened, motion_grid, padded
 from sim.params import StandParams
 from sim.prediction import corner_variants
 
@@ -51,6 +50,7 @@ __all__ = [
     "Plan",
     "Rival",
     "Setting",
+    "as_planned",
     "motion_grid",
     "plannable",
     "score",
@@ -60,15 +60,6 @@ __all__ = [
 FloatArray = NDArray[np.float64]
 Clock = Callable[[], float]
 
-#: The grid [estimate]: strokes, rates and ramps spanning the drive's range coarsely.
-AMPLITUDES_MM = (10.0, 25.0, 45.0, 70.0, 90.0)
-FREQUENCIES_HZ = (0.25, 0.5, 1.0, 1.5, 2.0, 3.0, 4.0)
-RAMP_FRACTIONS = (0.1, 0.25, 0.4)
-#: Each motion lasts about this long (cycles = rate × this, at least 2), s: long enough
-#: for the weight's response to settle into its cycle, short enough to keep the search
-#: cheap; the separation is an RMS, so more cycles would not raise it.
-MOTION_S = 3.0
-DWELL_START_S, DWELL_END_S = 0.5, 1.0
 #: How far below each limit a planned motion's worst case must stay, as a share of the
 #: limit: the range of k, c and friction covers the baseline's uncertainty, not effects
 #: the model lacks (on the other truth stand a pulley seat that jumps carried the weight
@@ -96,26 +87,6 @@ class Noise:
 
     u_m: float
     force_n: float
-
-
-@dataclass(frozen=True)
-class Candidate:
-    """A motion the search considers."""
-
-    spec: SignalSpec
-    mass_kg: float
-
-    def describe(self) -> str:
-        """'a 4 Hz trapezoid of 25 mm with 8.131 kg' and the like."""
-        kind = {
-            Shape.RECTANGULAR: "rectangle",
-            Shape.TRAPEZOIDAL: "trapezoid",
-            Shape.QUASI_SINUSOIDAL: "quasi-sine",
-        }[self.spec.shape]
-        return (
-            f"a {self.spec.frequency_hz:g} Hz {kind} of {self.spec.amplitude_m * 1e3:g} mm "
-            f"with {self.mass_kg:g} kg"
-        )
 
 
 @dataclass(frozen=True)
@@ -161,41 +132,6 @@ def score(separations: dict[tuple[str, str], float]) -> tuple[int, float]:
     """
     told = sum(sep >= DECISIVE for sep in separations.values())
     return told, min(separations.values(), default=0.0)
-
-
-def motion_grid(limits: DriveLimits, masses_kg: Sequence[float]) -> list[Candidate]:
-    """Every grid motion the drive can make, in a fixed scattered order.
-
-    The order is a seeded permutation, so that a search cut short by its budget has
-    still seen the whole range coarsely.
-    """
-    grid = []
-    for shape, a_mm, f_hz, mass in itertools.product(
-        Shape, AMPLITUDES_MM, FREQUENCIES_HZ, masses_kg
-    ):
-        ramps = RAMP_FRACTIONS if shape is Shape.TRAPEZOIDAL else (0.25,)
-        for ramp in ramps:
-            cycles = max(2, round(MOTION_S * f_hz))
-            spec = SignalSpec(shape, a_mm / 1e3, f_hz, cycles, ramp, DWELL_START_S, DWELL_END_S)
-            try:
-                plan_motion(spec, limits)
-            except LimitError:
-                continue
-            grid.append(Candidate(spec, mass))
-    order = np.random.default_rng(0).permutation(len(grid))
-    return [grid[i] for i in order]
-
-
-def _padded(
-    candidates: Sequence[Candidate], limits: DriveLimits, rate_hz: float
-) -> tuple[FloatArray, list[int]]:
-    """The motions' drive positions padded with rest to one length, and their lengths."""
-    xs = [plan_motion(c.spec, limits).sample(rate_hz)[1] for c in candidates]
-    n = max(x.size for x in xs)
-    out = np.zeros((len(xs), n))
-    for row, x in zip(out, xs, strict=True):
-        row[: x.size] = x
-    return out, [x.size for x in xs]
 
 
 @dataclass(frozen=True)
@@ -307,13 +243,16 @@ def _separations(
     }  # fmt: skip
 
 
+#: A judged motion: its score, itself, each pair's separation, its safety prediction.
+_Judged = tuple[tuple[int, float], Candidate, dict[tuple[str, str], float], Prediction]
+
+
 def search(
     setting: Setting, grid: Sequence[Candidate], budget_s: float, clock: Clock = time.monotonic
 ) -> Plan:
     """Search the grid (in its order) until done or the budget is spent."""
     started = clock()
-    best: tuple[tuple[int, float], Candidate, dict[tuple[str, str], float], Prediction] | None
-    best = None
+    best: _Judged | None = None
     searched = 0
     options: list[Candidate] = []
     complete = True
@@ -331,14 +270,30 @@ def search(
                     best = found
     if best is None:
         return Plan(None, {}, None, searched, 0, complete)
+    best = _as_planned(setting, best)
     return Plan(best[1], best[2], best[3], searched, len(options), complete, tuple(options))
 
 
-def _judge(
-    setting: Setting, mass: float, group: Sequence[Candidate]
-) -> list[tuple[tuple[int, float], Candidate, dict[tuple[str, str], float], Prediction]]:
+def _as_planned(setting: Setting, found: _Judged) -> _Judged:
+    """The motion lengthened to the planned test's length, if that too is admissible."""
+    longer = lengthened(found[1], setting.limits)
+    judged = _judge(setting, longer.mass_kg, [longer])
+    return judged[0] if judged else found
+
+
+def as_planned(setting: Setting, candidate: Candidate) -> Candidate:
+    """A searched motion as a test is planned: lengthened (``lengthened``) if still admissible.
+
+    The search judges short motions; the plan runs the chosen one longer, and a check that
+    draws a motion among ``Plan.options`` runs it the same way.
+    """
+    longer = lengthened(candidate, setting.limits)
+    return longer if _judge(setting, longer.mass_kg, [longer]) else candidate
+
+
+def _judge(setting: Setting, mass: float, group: Sequence[Candidate]) -> list[_Judged]:
     """The group's admissible motions: (score, motion, separations, prediction) each."""
-    x, lengths = _padded(group, setting.limits, setting.rate_hz)
+    x, lengths = padded(group, setting.limits, setting.rate_hz)
     predictions = _predictions(setting, mass, x, lengths)
     ok = [i for i, p in enumerate(predictions) if _admissible(p, setting)]
     if not ok:
