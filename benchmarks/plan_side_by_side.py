@@ -49,7 +49,8 @@ BUDGET_S = 120.0
 def _answer(d: dict[str, Any]) -> dict[str, Any]:
     named = [e["effect"] for e in d["effects"]]
     rivals = d["effects"][0]["indistinguishable_from"] if named else []
-    return {"verdict": d["verdict"], "named": named, "rivals": rivals}
+    ranked = [r["effect"] for r in d["ranking"]]
+    return {"verdict": d["verdict"], "named": named, "rivals": rivals, "ranking": ranked}
 
 
 def right(truth: str, answer: dict[str, Any]) -> bool:
@@ -128,6 +129,7 @@ def campaign(seed: int, k: int, truth: str, mass: float, recordings: str) -> dic
             return out
         plan = answer.plan
         out["plan"] = {"why": answer.line(), "expected_separation": plan.expected_separation,
+                       "separates": {f"{a} / {b}": v for (a, b), v in plan.separations.items()},
                        "admissible": plan.admissible, "complete": plan.complete}  # fmt: skip
         if plan.best is not None:
             drawn = plan.options[int(np.random.default_rng([seed, k, 1]).integers(plan.admissible))]

@@ -214,19 +214,20 @@ def _separations(
 ) -> dict[tuple[str, str], float]:
     """Each pair's separation on motion j, on the diagnosis' segments, the lesser way round."""
     n = x.size
-    recordings = {
-        name: recording_of(name, x, r.u_m[j, :n], r.force_n[j, :n], setting.rate_hz, stand.mass_kg)
-        for name, r in runs.items()
-    }
-    models = {rival.name: rival.effects for rival in setting.rivals}
     noise = setting.noise
+    recordings = {
+        name: recording_of(name, x, r.u_m[j, :n], r.force_n[j, :n], setting.rate_hz,
+                           stand.mass_kg, (noise.u_m, noise.force_n))
+        for name, r in runs.items()
+    }  # fmt: skip
+    models = {rival.name: rival.effects for rival in setting.rivals}
     misses: dict[tuple[str, str], float] = {}
 
     def miss(truth: str, model: str) -> float:
         if (truth, model) not in misses:
             misses[(truth, model)] = shooting_separation(
                 recordings[truth], stand, models[truth], models[model], noise.u_m, noise.force_n
-            )
+            ).against_floor
         return misses[(truth, model)]
 
     def nested(inner: str, outer: str) -> bool:

@@ -29,9 +29,10 @@ def _motion(shape: Shape, amplitude_mm: float, frequency_hz: float, mass: float)
     return x, config.stand_params("final", mass), config.sample_rate_hz
 
 
-def _recorded(stand, effects, x, rate):  # type: ignore[no-untyped-def]
+def _recorded(stand, effects, x, rate, noisy=False):  # type: ignore[no-untyped-def]
     run = Model(stand, effects).run(x, rate)
-    return recording_of("truth", x, run.u_m, run.force_n, rate, stand.mass_kg)
+    noise = (NOISE_U, NOISE_F) if noisy else (0.0, 0.0)
+    return recording_of("truth", x, run.u_m, run.force_n, rate, stand.mass_kg, noise)
 
 
 def test_the_residual_counts_only_what_a_refit_would_not_absorb() -> None:
@@ -63,9 +64,9 @@ def test_chaos_after_a_snatch_is_not_a_separation() -> None:
     )
     assert open_loop > 100.0
     # restarted from the measured states (and refitted) it misses by a sliver of the noise
-    assert shooting_separation(truth, stand, maxwell, nearly, NOISE_U, NOISE_F) < 0.1
+    assert shooting_separation(truth, stand, maxwell, nearly, NOISE_U, NOISE_F).beyond_refit < 0.1
     # and what the restarts miss themselves is common to both: nothing for the truth
-    assert shooting_separation(truth, stand, maxwell, maxwell, NOISE_U, NOISE_F) < 1e-6
+    assert shooting_separation(truth, stand, maxwell, maxwell, NOISE_U, NOISE_F).beyond_refit < 1e-6
 
 
 def test_a_skew_and_a_gauge_low_pass_part_in_the_snatches() -> None:
@@ -74,23 +75,46 @@ def test_a_skew_and_a_gauge_low_pass_part_in_the_snatches() -> None:
     gentle = min(
         shooting_separation(
             _recorded(stand, (SKEW,), x, rate), stand, (SKEW,), (GAUGE,), NOISE_U, NOISE_F
-        ),
+        ).beyond_refit,
         shooting_separation(
             _recorded(stand, (GAUGE,), x, rate), stand, (GAUGE,), (SKEW,), NOISE_U, NOISE_F
-        ),
+        ).beyond_refit,
     )
     # ... a snatch of a slack fibre (a step of F) shows the gauge's ring and the skew's shift
     x, stand, rate = _motion(Shape.RECTANGULAR, 10.0, 1.5, 3.096)
     snatched = min(
         shooting_separation(
             _recorded(stand, (SKEW,), x, rate), stand, (SKEW,), (GAUGE,), NOISE_U, NOISE_F
-        ),
+        ).beyond_refit,
         shooting_separation(
             _recorded(stand, (GAUGE,), x, rate), stand, (GAUGE,), (SKEW,), NOISE_U, NOISE_F
-        ),
+        ).beyond_refit,
     )
     assert gentle < 0.5
     assert snatched > 1.5
+
+
+def test_the_floor_is_the_noise_on_a_taut_fibre_and_more_after_snatches() -> None:
+    # never slack: one open-loop run, the truth misses its noisy recording by the noise
+    x, stand, rate = _motion(Shape.QUASI_SINUSOIDAL, 45.0, 1.0, 8.131)
+    taut = shooting_separation(
+        _recorded(stand, (SKEW,), x, rate, noisy=True), stand, (SKEW,), (GAUGE,), NOISE_U, NOISE_F
+    )
+    assert taut.channel_floor == pytest.approx((1.0, 1.0), rel=0.05)  # 1 noise unit each
+    # snatches: restarts from states estimated on noisy channels miss more than the noise,
+    # for the right model too; the rivals' difference counts against that floor
+    x, stand, rate = _motion(Shape.RECTANGULAR, 10.0, 1.5, 3.096)
+    snatched = shooting_separation(
+        _recorded(stand, (SKEW,), x, rate, noisy=True), stand, (SKEW,), (GAUGE,), NOISE_U, NOISE_F
+    )
+    assert max(snatched.channel_floor) > 2.0
+    ratios = [
+        m / max(f, 1.0) for m, f in zip(snatched.channel_miss, snatched.channel_floor, strict=True)
+    ]
+    assert snatched.against_floor == pytest.approx(
+        np.sqrt((1 + ratios[0] ** 2) * (1 + ratios[1] ** 2) - 1)
+    )
+    assert snatched.against_floor < max(snatched.channel_miss)
 
 
 def test_effect_steps_stay_in_range_and_move_every_fitted_parameter() -> None:
