@@ -4,10 +4,11 @@ The rivals of the diagnosis of a campaign with a 1.1 ms force-channel skew (name
 force_gauge_dynamics, indistinguishable from channel_time_skew), the stand file's two
 weights, the whole grid. Ours: ``sim.planner.search`` (each chunk of 24 motions is one
 batch for the prediction's 9 corners and one per rival; on each admissible motion, per
-pair and way round, one batch of segment runs: the model at its values and a step of
-each refitted parameter, on all cores). Reference, in the same run: the same judgements
-with one ``Model.run`` per motion and corner, per rival, and one ``run_segments`` per
-refit step, on the grid's first 24 motions, scaled to the whole grid. Median of three
+pair and way round, one batch of segment runs of each rival from the other's noisy
+recording: its values and a step of each refitted parameter, on all cores). Reference,
+in the same run: the same judgements with one ``Model.run`` per motion and corner, per
+rival, and one ``run_segments`` per rival and refit step, on the grid's first 24 motions,
+scaled to the whole grid. Median of three
 runs each (a first run compiles; it is not counted).
 
 Run: ``.venv/bin/python benchmarks/bench_plan.py``.
@@ -16,14 +17,17 @@ Run: ``.venv/bin/python benchmarks/bench_plan.py``.
 from __future__ import annotations
 
 import time
+from typing import Any
 
 import numpy as np
 
 from drivers.signals import plan_motion
 from sim.config import default_config
-from sim.discrimination import baseline_steps, effect_steps, recording_of, residual_separation
+from sim.discrimination import baseline_steps, effect_steps, recording_of
 from sim.effects import EffectSpec
 from sim.envelope import FITTED_SPREAD, Prediction, SlackRule, figures_of, worst_of
+from sim.identify.shooting import Segments
+from sim.identify.traces import Trace
 from sim.model import Model
 from sim.planner import CHUNK, Noise, Rival, Setting, motion_grid, plannable, search
 
@@ -66,20 +70,29 @@ def one_at_a_time(s: Setting, motions: list) -> None:  # type: ignore[type-arg]
             continue
         runs = {r.name: Model(stand, r.effects).run(x, s.rate_hz) for r in s.rivals}
         models = {r.name: r.effects for r in s.rivals}
+        noise = (s.noise.u_m, s.noise.force_n)
         for a, b in s.pairs:
             for truth, other in ((a, b), (b, a)):
-                rec = recording_of(truth, x, runs[truth].u_m, runs[truth].force_n, s.rate_hz,
-                                   c.mass_kg)  # fmt: skip
-                seg = rec.segments
+                run = runs[truth]
+                rec = recording_of(truth, x, run.u_m, run.force_n, s.rate_hz, c.mass_kg, noise)
+
+                def scaled(model: Model, rec: Trace = rec, seg: Segments = rec.segments) -> Any:
+                    u, f = model.run_segments(rec.x_m, s.rate_hz, seg.restarts)
+                    return np.concatenate([seg.assemble(u)[0] / s.noise.u_m,
+                                           seg.assemble(f)[0] / s.noise.force_n])  # fmt: skip
+
+                target = scaled(Model(stand, models[truth]))
                 model = Model(stand, models[other])
                 steps = [{}, *baseline_steps(stand), *effect_steps(models[other])]
-                z = []
-                for step in steps:
-                    u, f = model.variant(step).run_segments(rec.x_m, s.rate_hz, seg.restarts)
-                    z.append(np.concatenate([seg.assemble(u)[0] / s.noise.u_m,
-                                             seg.assemble(f)[0] / s.noise.force_n]))  # fmt: skip
+                z = [scaled(model.variant(step)) for step in steps]
+                miss = target - z[0]
+                directions = np.column_stack([v - z[0] for v in z[1:]])
+                miss -= directions @ np.linalg.lstsq(directions, miss, rcond=None)[0]
                 data = np.concatenate([rec.u_m / s.noise.u_m, rec.force_n / s.noise.force_n])
-                residual_separation(data - z[0], np.column_stack([v - z[0] for v in z[1:]]))
+                held = np.concatenate([rec.test, rec.test])
+                float(
+                    np.sqrt(np.mean(miss[held] ** 2)) / np.sqrt(np.mean((data - target)[held] ** 2))
+                )
 
 
 def main() -> None:

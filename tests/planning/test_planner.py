@@ -210,3 +210,9 @@ def test_the_line_says_how_many_pairs_and_whether_the_worst_is_told_apart() -> N
     many = line({("a", "none"): 2.5, ("b", "none"): 1.2, ("c", "none"): 0.4})
     assert "tells 2 of 3 rival pairs apart; the worst, c from none, by 0.4 noise units" in many
     assert "hardly told apart" not in line({("a", "none"): 2.5, ("b", "none"): 1.2})
+
+
+def test_the_command_and_the_search_agree_on_what_tells_a_pair_apart() -> None:
+    import labstand.planning
+
+    assert labstand.planning.DECISIVE == DECISIVE  # the CLI keeps a copy to load no numba
