@@ -10,14 +10,14 @@ snatch) and misses what it will (a force channel's delay against a gauge low-pas
 differs most in the snatches themselves).
 
 So, for a motion and two rivals A and B: A's open-loop run with the gauges' noise stands
-in for the recording (A is the truth), it is cut into segments exactly as a recording would be
-(``Trace.segments``), and A and B both run from its measured states on those segments,
-B at its values and one step off each parameter a re-diagnosis refits (the baseline's
+in for the recording (A is the truth) and is cut into segments exactly as a recording
+is (``Trace.segments``); A and B both run from its measured states on those segments, B
+at its values and one step off each parameter a re-diagnosis refits (the baseline's
 stiffness, damping and friction scales, B's own effect parameters). What remains of
-A − B beyond those directions (least squares), RMS in noise units, is how far B misses
-if A is true, and it is seen against what A itself misses there (the noise and the
-restarts' own error: ``Miss``); the pair's separation is the lesser of the two ways
-round, since either may be the truth.
+A − B beyond those directions (least squares) is how far B misses if A is true; per
+channel on the held-out cycles it counts against what A itself misses there, the noise
+plus the restarts' own error (``Miss.against_floor``). The pair's separation is the
+lesser of the two ways round, since either may be the truth (``sim.planner``).
 """
 
 from __future__ import annotations
