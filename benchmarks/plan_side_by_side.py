@@ -1,119 +1,227 @@
 """Check: does the planned test settle an ambiguous diagnosis better than a random one?
 
-Campaigns of a force channel that lags (``channel_time_skew`` at a drawn delay) recorded
-by ``labstand simulate --noise`` on the validation's quick, medium and slow signals; each
-whose diagnosis is ambiguous (a rival listed as indistinguishable) gets one more
-recording twice, side by side: the motion ``labstand plan`` chooses, and a motion drawn
-at random among those the safety prediction admits (fibre slack ≤ 5 % as the planner's).
-Each is diagnosed again with the three starting recordings. Right: the truth is the named
-effect; settled: and no rival is left beside it.
+Campaigns of the other truth stand (``sim.checks.otherstand``: its own integrator and
+effect forms, a true stand drawn off nominal, one effect at drawn parameters) recorded
+on a starting set (``--recordings``, default the other stand's ``gentle`` three: small
+strokes, the fibre never slack, a lab sparing its fibre, where six of the nine truths
+barely show), at each weight in turn. The first diagnosis is *ambiguous* when its named
+effect has a rival it cannot tell apart (``indistinguishable_from``) or its answer is
+wrong (the truth not named first; for ``none`` an effect named; for an effect outside
+the catalogue anything but ``unexplained``). Each ambiguous campaign gets one more
+recording twice, side by side on the same true stand: the motion ``labstand plan``
+chooses (``plan_motion_for``, both weights), and one drawn at random among the motions
+the same search admitted (the same count: one each), each run as long as a plan runs
+(``sim.motions.PLAN_S``). Each is diagnosed again with the starting recordings. Right:
+the truth named first (or the right verdict); settled: right with no rival left beside it.
 
-Run: ``.venv/bin/python benchmarks/plan_side_by_side.py [--campaigns N] [--dir DIR]``.
+Campaigns run in a process pool (``--jobs``); each finished one is appended to
+``--out`` as one JSON line at once, and a rerun with the same ``--out`` skips campaigns
+already there (``--only``: just these campaign numbers). ``--summary FILE`` prints the
+counts of a results file.
+
+Run: ``.venv/bin/python benchmarks/plan_side_by_side.py --campaigns 18 --jobs 1 --out r.jsonl``.
 """
 
 from __future__ import annotations
 
 import argparse
-import subprocess
+import json
+import os
 import sys
-import tempfile
+import time
+from collections.abc import Sequence
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from multiprocessing import get_context
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
-from drivers.signals import SignalSpec, plan_motion
-from labstand.commands.plan import diagnosed, noise_of, traces_of
-from labstand.planning import plan_motion_for
-from sim.config import default_config
-from sim.envelope import NOMINAL_SPREAD, SlackRule
-from sim.planner import PREDICTABLE_SLACK, motion_grid
-from sim.prediction import predict
-
-TRUTH = "channel_time_skew"
-RULE = SlackRule(2.0, 0.25)
-STARTING = {
-    "quick": ["--signal", "trapezoidal", "--amplitude-mm", "25", "--frequency-hz", "2",
-              "--cycles", "4", "--ramp-fraction", "0.4"],
-    "medium": ["--signal", "trapezoidal", "--amplitude-mm", "25", "--frequency-hz", "1.25",
-               "--cycles", "4", "--ramp-fraction", "0.4"],
-    "slow": ["--signal", "quasi-sinusoidal", "--amplitude-mm", "60", "--frequency-hz", "0.5",
-             "--cycles", "3"],
-}  # fmt: skip
+CATALOGUE = (
+    "fibre_viscoelastic", "fibre_transverse_vibration", "fibre_pulley_jump",
+    "pulley_inertia_friction", "stick_slip_friction", "side_load_friction",
+    "dial_gauge_calibration", "channel_time_skew", "force_gauge_dynamics",
+)  # fmt: skip
+#: The search's budget per plan, s: the whole grid on a loaded core.
+BUDGET_S = 120.0
 
 
-def simulate(out: Path, signal: list[str], effect: str, seed: int) -> Path:
-    cmd = [sys.executable, "-m", "labstand", "simulate", *signal, "--effect", effect,
-           "--noise", "--seed", str(seed), "-o", str(out)]  # fmt: skip
-    subprocess.run(cmd, check=True, capture_output=True)
+def _answer(d: dict[str, Any]) -> dict[str, Any]:
+    named = [e["effect"] for e in d["effects"]]
+    rivals = d["effects"][0]["indistinguishable_from"] if named else []
+    ranked = [r["effect"] for r in d["ranking"]]
+    return {"verdict": d["verdict"], "named": named, "rivals": rivals, "ranking": ranked}
+
+
+def right(truth: str, answer: dict[str, Any]) -> bool:
+    """The truth named first; ``none``: nothing named; outside the catalogue: unexplained."""
+    named = answer["named"]
+    if truth == "none":
+        return not named
+    if truth not in CATALOGUE:
+        return not named and answer["verdict"] == "unexplained"
+    return bool(named) and named[0] == truth
+
+
+def settled(truth: str, answer: dict[str, Any]) -> bool:
+    """Right, and no rival the recordings cannot tell from it."""
+    return right(truth, answer) and not answer["rivals"]
+
+
+def _diagnosis(traces: Sequence[Any], nominal: Any) -> dict[str, Any]:
+    from sim.identify import diagnose
+
+    result: dict[str, Any] = diagnose(traces, nominal).to_dict()
+    return result
+
+
+def _recorded(camp: Any, spec: Any, mass: float, name: str, rng: np.random.Generator) -> Any:
+    """One more recording of the campaign's true stand (its effects, the other weight too)."""
+    from drivers.signals import plan_motion
+    from sim.checks.otherstand import simulate
+    from sim.checks.otherstand.gauges import Realism
+    from sim.config import default_config
+    from sim.identify.traces import make_trace
+
+    config = default_config()
+    rate = config.sample_rate_hz
+    t, x = plan_motion(spec, config.drive).sample(rate)
+    run = simulate(camp.stand.with_(mass_kg=mass), camp.effects, x, rate)
+    x_rec, u_rec, f_rec = Realism().apply(x, run.u_m, run.force_n, rate, rng)
+    return make_trace(name, t, x_rec, u_rec, f_rec, mass)
+
+
+def campaign(seed: int, k: int, truth: str, mass: float, recordings: str) -> dict[str, Any]:
+    """One campaign: first diagnosis, and if ambiguous the plan, a random draw, both judged."""
+    from labstand.commands.plan import noise_of
+    from labstand.errors import CommandError
+    from labstand.fitted import fitted_from_dict
+    from labstand.planning import plan_motion_for, setting_for
+    from sim.checks.otherstand.campaign import OTHER_SETS, make_other_campaign
+    from sim.config import default_config
+    from sim.envelope import SlackRule
+    from sim.identify.traces import make_trace
+    from sim.planner import as_planned
+
+    started = time.perf_counter()
+    config = default_config()
+    nominal = config.stand_params("final", mass)
+    rng = np.random.default_rng([seed, k])
+    camp = make_other_campaign(nominal, [] if truth == "none" else [truth], rng,
+                               OTHER_SETS[recordings], config.sample_rate_hz)  # fmt: skip
+    traces = [make_trace(n, t, x, u, f, mass) for n, t, x, u, f in camp.recordings]
+    first = _diagnosis(traces, config.stand_params("final"))
+    out: dict[str, Any] = {
+        "seed": seed, "campaign": k, "truth": truth, "mass_kg": mass, "recordings": recordings,
+        "params": camp.effects, "first": _answer(first),
+    }  # fmt: skip
+    out["ambiguous"] = bool(out["first"]["rivals"]) or not right(truth, out["first"])
+    if out["ambiguous"]:
+        fitted = fitted_from_dict(first, Path("(first diagnosis)"))
+        rule = SlackRule(2.0, 0.25)
+        masses = sorted(config.weights_kg.values())
+        try:
+            answer = plan_motion_for(fitted, config, masses, noise_of(traces), rule, BUDGET_S)
+            setting = setting_for(fitted, config, noise_of(traces), rule)
+        except CommandError as err:  # no rivals to separate: counted as no plan
+            out["plan"] = {"why": str(err)}
+            out["seconds"] = time.perf_counter() - started
+            return out
+        plan = answer.plan
+        out["plan"] = {"why": answer.line(), "expected_separation": plan.expected_separation,
+                       "separates": {f"{a} / {b}": v for (a, b), v in plan.separations.items()},
+                       "admissible": plan.admissible, "complete": plan.complete}  # fmt: skip
+        if plan.best is not None:
+            drawn = plan.options[int(np.random.default_rng([seed, k, 1]).integers(plan.admissible))]
+            drawn = as_planned(setting, drawn)  # run as long as a plan runs
+            for label, choice in (("planned", plan.best), ("random", drawn)):
+                extra = _recorded(camp, choice.spec, choice.mass_kg, label,
+                                  np.random.default_rng([seed, k, 2]))  # fmt: skip
+                again = _answer(_diagnosis([*traces, extra], config.stand_params("final")))
+                judged = {"right": right(truth, again), "settled": settled(truth, again)}
+                out[label] = {**again, "motion": choice.describe(), **judged}
+    out["seconds"] = time.perf_counter() - started
     return out
 
 
-def signal_options(spec: SignalSpec, mass: float) -> list[str]:
-    return [
-        "--signal", str(spec.shape), "--amplitude-mm", f"{spec.amplitude_m * 1e3:g}",
-        "--frequency-hz", f"{spec.frequency_hz:g}", "--cycles", str(spec.cycles),
-        "--ramp-fraction", f"{spec.ramp_fraction:g}", "--mass-kg", f"{mass:g}",
-    ]  # fmt: skip
+def summary(lines: Sequence[dict[str, Any]]) -> dict[str, Any]:
+    """Counts over the ambiguous campaigns: planned and random, right and settled."""
+    ambiguous = [r for r in lines if r["ambiguous"]]
+    counted = [r for r in ambiguous if "planned" in r]
+    return {
+        "campaigns": len(lines),
+        "ambiguous": len(ambiguous),
+        "with_a_plan": len(counted),
+        **{
+            f"{label}_{what}": sum(r[label][what] for r in counted)
+            for label in ("planned", "random")
+            for what in ("right", "settled")
+        },
+        "by_truth": {
+            t: f"{sum(r['planned']['right'] for r in counted if r['truth'] == t)}"
+            f"/{sum(r['random']['right'] for r in counted if r['truth'] == t)}"
+            f" of {sum(r['truth'] == t for r in counted)}"
+            for t in dict.fromkeys(r["truth"] for r in counted)
+        },
+    }
 
 
-def random_admissible(rng: np.random.Generator, mass: float) -> tuple[SignalSpec, float]:
-    config = default_config()
-    grid = motion_grid(config.drive, [mass])
-    while True:
-        c = grid[int(rng.integers(len(grid)))]
-        x = plan_motion(c.spec, config.drive).sample(config.sample_rate_hz)[1]
-        stand = config.stand_params("final", c.mass_kg)
-        p = predict(stand, (), x, config.sample_rate_hz, NOMINAL_SPREAD, RULE.slack_force_n)
-        if not p.breaches(config.envelope, RULE) and p.worst.slack_share <= PREDICTABLE_SLACK:
-            return c.spec, c.mass_kg
-
-
-def judge(paths: list[Path]) -> tuple[bool, bool, str]:
-    fitted, _ = diagnosed(traces_of(paths, None), default_config(), "side-by-side")
-    named = [e.name for e in fitted.effects]
-    rivals = fitted.indistinguishable.get(named[0], []) if named else []
-    right = bool(named) and named[0] == TRUTH
-    return right, right and not rivals, f"{'+'.join(named) or 'none'} {rivals or ''}"
+def _read(path: Path) -> list[dict[str, Any]]:
+    if not path.exists():
+        return []
+    return [json.loads(line) for line in path.read_text().splitlines() if line.strip()]
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--campaigns", type=int, default=6)
-    parser.add_argument("--dir", type=Path, default=None)
+    parser.add_argument("--campaigns", type=int, default=18)
+    parser.add_argument("--seed", type=int, default=2026)
+    parser.add_argument("--truths", default=",".join(CATALOGUE),
+                        help="comma-separated: catalogue effects, none, outside ones")  # fmt: skip
+    parser.add_argument("--recordings", default="gentle", help="the other stand's starting set")
+    parser.add_argument("--only", help="comma-separated campaign numbers (default: all)")
+    parser.add_argument("--jobs", type=int, default=1, help="campaigns at once (processes)")
+    parser.add_argument("--out", type=Path, default=Path("plan_side_by_side.jsonl"))
+    parser.add_argument("--summary", type=Path, help="only print the counts of this file")
     args = parser.parse_args()
-    folder = args.dir or Path(tempfile.mkdtemp(prefix="plan-sbs-"))
-    rng = np.random.default_rng(2026)
-    config = default_config()
-    counts = {"ambiguous": 0, "planned right": 0, "planned settled": 0, "random right": 0,
-              "random settled": 0}  # fmt: skip
-    for k in range(args.campaigns):
-        skew = float(rng.uniform(0.5e-3, 2.0e-3))
-        effect = f"{TRUTH}:force_skew_s={skew:.6f}"
-        start = [simulate(folder / f"c{k}-{n}.h5", s, effect, 10 * k + i)
-                 for i, (n, s) in enumerate(STARTING.items())]  # fmt: skip
-        fitted, _ = diagnosed(traces_of(start, None), config, "side-by-side")
-        named = [e.name for e in fitted.effects]
-        rivals = fitted.indistinguishable.get(named[0], []) if named else []
-        print(f"campaign {k}: skew {skew * 1e3:.2f} ms; first: {named} {rivals}", flush=True)
-        if not rivals and named and named[0] == TRUTH:
-            continue  # settled at once: nothing to plan
-        counts["ambiguous"] += 1
-        answer = plan_motion_for(fitted, config, [8.131], noise_of(traces_of(start, None)),
-                                 RULE, 60.0)  # fmt: skip
-        assert answer.plan.best is not None
-        planned = simulate(folder / f"c{k}-planned.h5",
-                           signal_options(answer.plan.best.spec, answer.plan.best.mass_kg),
-                           effect, 10 * k + 5)  # fmt: skip
-        spec, mass = random_admissible(rng, 8.131)
-        drawn = simulate(folder / f"c{k}-random.h5", signal_options(spec, mass), effect,
-                         10 * k + 6)  # fmt: skip
-        for label, extra in (("planned", planned), ("random", drawn)):
-            right, settled, words = judge([*start, extra])
-            counts[f"{label} right"] += right
-            counts[f"{label} settled"] += settled
-            print(f"  {label}: {words}", flush=True)
-        print(f"  plan: {answer.line()}", flush=True)
-    print(counts)
+    if args.summary is not None:
+        print(json.dumps(summary(_read(args.summary)), indent=2))
+        return
+    # Each process its share of the cores (numba reads this when a worker first imports it).
+    os.environ["NUMBA_NUM_THREADS"] = str(max(1, (os.cpu_count() or 1) // max(args.jobs, 1)))
+    from sim.config import default_config
+
+    truths = args.truths.split(",")
+    masses = sorted(default_config().weights_kg.values())
+    done = {(r["seed"], r["campaign"]) for r in _read(args.out)}
+    todo = [
+        (args.seed, k, truths[k % len(truths)], masses[(k // len(truths)) % len(masses)],
+         args.recordings)
+        for k in range(args.campaigns) if (args.seed, k) not in done
+    ]  # fmt: skip
+    if args.only:
+        todo = [job for job in todo if str(job[1]) in args.only.split(",")]
+    with (
+        ProcessPoolExecutor(args.jobs, mp_context=get_context("spawn")) as pool,
+        args.out.open("a") as sink,
+    ):
+        futures = {pool.submit(campaign, *job): job for job in todo}
+        for future in as_completed(futures):
+            try:
+                line = future.result()
+            except Exception as err:  # a failed campaign is reported, the others go on
+                print(f"campaign {futures[future][1]} failed: {err!r}", file=sys.stderr)
+                continue
+            sink.write(json.dumps(line) + "\n")
+            sink.flush()
+            mark = ("planned " + ("right" if line["planned"]["right"] else "wrong")
+                    + ", random " + ("right" if line["random"]["right"] else "wrong")
+                    if "planned" in line else "not ambiguous" if not line["ambiguous"]
+                    else "no plan")  # fmt: skip
+            print(f"campaign {line['campaign']} ({line['truth']}, {line['mass_kg']:g} kg, "
+                  f"{line['seconds']:.0f} s): first {line['first']['named']} "
+                  f"{line['first']['rivals']}: {mark}", flush=True)  # fmt: skip
+    print(json.dumps(summary(_read(args.out)), indent=2))
 
 
 if __name__ == "__main__":

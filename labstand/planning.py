@@ -2,8 +2,8 @@
 
 The rivals (``rivals_of``): the named effect against each candidate the recordings could
 not tell from it (``indistinguishable_from``); failing those, against the runner-up of the
-ranking and against the baseline alone; with nothing named, the ranking's two best
-against the baseline and each other. Each rival is the diagnosis' fitted baseline plus
+ranking and against the baseline alone; with nothing named, each of the ranking's
+``MAX_UNNAMED`` best against the baseline. Each rival is the diagnosis' fitted baseline plus
 its effect at the parameters its own refit found (the ranking's ``params``).
 """
 
@@ -21,17 +21,26 @@ if TYPE_CHECKING:
     from labstand.fitted import FittedStand
     from sim.config import StandConfig
     from sim.envelope import SlackRule
-    from sim.planner import Noise, Plan, Rival
+    from sim.planner import Noise, Plan, Rival, Setting
 
-__all__ = ["PLAN_OPTIONS", "PlanAnswer", "plan_motion_for", "rivals_of", "signal_from_plan"]
+__all__ = [
+    "PLAN_OPTIONS",
+    "PlanAnswer",
+    "plan_motion_for",
+    "rivals_of",
+    "setting_for",
+    "signal_from_plan",
+]
 
 BASELINE = "none"
-#: A separation below this many noise units (RMS, beyond what refits absorb) counts as
-#: hardly telling the rivals apart [estimate]: their outputs differ by less than the
-#: gauges' noise, and a re-diagnosis may well not settle it.
-DECISIVE = 1.0
-#: At most this many pairs are separated (each costs one batch of runs per rival).
+#: A separation below this many noise units counts as hardly telling the rivals apart.
+DECISIVE = 1.0  # sim.planner.DECISIVE; here without importing the simulation
+#: At most this many pairs are separated when an effect is named (each costs one batch
+#: of segment runs per motion, each way round).
 MAX_PAIRS = 3
+#: With nothing named, this many of the ranking's best candidates each against the
+#: baseline: the question is which of them the stand has, if any.
+MAX_UNNAMED = 5
 
 
 def rivals_of(fitted: FittedStand) -> tuple[list[Rival], list[tuple[str, str]]]:
@@ -49,16 +58,14 @@ def rivals_of(fitted: FittedStand) -> tuple[list[Rival], list[tuple[str, str]]]:
             others = [*ranked[:1], BASELINE]
         pairs = [(first, other) for other in others]
     elif ranked:
-        pairs = [(ranked[0], BASELINE)]
-        if len(ranked) > 1:
-            pairs += [(ranked[0], ranked[1]), (ranked[1], BASELINE)]
+        pairs = [(name, BASELINE) for name in ranked[:MAX_UNNAMED]]
     if not pairs:
         raise CommandError(
             f"{fitted.source}: no rival explanations to separate (nothing named, no ranked "
             "candidate with fitted parameters)",
             ExitCode.USAGE,
         )
-    pairs = pairs[:MAX_PAIRS]
+    pairs = pairs[: MAX_PAIRS if named else MAX_UNNAMED]
     rest = tuple(named[1:])
     models: dict[str, Rival] = {}
     for name in {n for pair in pairs for n in pair}:
@@ -98,8 +105,16 @@ class PlanAnswer:
         (a, b), sep = min(plan.separations.items(), key=lambda kv: kv[1])
         worst = plan.prediction.worst
         weak = "" if self.decisive else f" only (below {DECISIVE:g}: hardly told apart)"
+        told = sum(v >= DECISIVE for v in plan.separations.values())
+        pairs = len(plan.separations)
+        what = (
+            f"separates {a} from {b} by {sep:.1f} noise units{weak}"
+            if pairs == 1
+            else f"tells {told} of {pairs} rival pairs apart; the worst, {a} from {b}, by "
+            f"{sep:.1f} noise units{weak}"
+        )
         return (
-            f"{plan.best.describe()} separates {a} from {b} by {sep:.1f} noise units{weak}; "
+            f"{plan.best.describe()} {what}; "
             f"predicted slack {worst.slack_share:.0%}, peak {worst.peak_tension_n:.0f} N, "
             f"weight travel {worst.weight_travel_m * 1e3:.0f} mm"
         )
@@ -141,19 +156,12 @@ class PlanAnswer:
         return out
 
 
-def plan_motion_for(
-    fitted: FittedStand,
-    config: StandConfig,
-    masses_kg: list[float],
-    noise: Noise,
-    rule: SlackRule,
-    budget_s: float,
-) -> PlanAnswer:
-    """Search the stand's motions for the one that best separates the diagnosis' rivals."""
-    from sim.planner import Setting, motion_grid, search
+def setting_for(fitted: FittedStand, config: StandConfig, noise: Noise, rule: SlackRule) -> Setting:
+    """What the search needs of a diagnosis and a stand (its rivals, model, limits)."""
+    from sim.planner import Setting
 
     rivals, pairs = rivals_of(fitted)
-    setting = Setting(
+    return Setting(
         nominal=config.stand_params("final"),
         spread=fitted.spread(),
         named=fitted.effects,
@@ -165,6 +173,20 @@ def plan_motion_for(
         limits=config.drive,
         rate_hz=config.sample_rate_hz,
     )
+
+
+def plan_motion_for(
+    fitted: FittedStand,
+    config: StandConfig,
+    masses_kg: list[float],
+    noise: Noise,
+    rule: SlackRule,
+    budget_s: float,
+) -> PlanAnswer:
+    """Search the stand's motions for the one that best separates the diagnosis' rivals."""
+    from sim.planner import motion_grid, search
+
+    setting = setting_for(fitted, config, noise, rule)
     plan = search(setting, motion_grid(config.drive, masses_kg), budget_s)
     return PlanAnswer(plan, fitted, config, rule, noise, budget_s)
 

@@ -3,21 +3,21 @@
 A *rival* is one explanation of a stand's gap as a model: the fitted baseline plus its
 effects at their fitted parameters. For each motion of a coarse grid (shapes, strokes,
 rates, ramps, weights), the safety prediction (``sim.prediction``, worst over the
-parameters' range and over the rivals, ``PLAN_MARGIN`` below every limit, little slack)
-decides whether it may run; on those that may, each rival runs open loop from rest, at
-its values and a step off each of its parameters. The *separation* of two rivals is the
-RMS difference of their recorded channels over the motion, in units of the gauges' noise
-(u and F together), after projecting off what a re-diagnosis would refit: the baseline's
-stiffness, damping and friction and both rivals' own parameters. The plan is the
-admissible motion with the largest separation of its worst-separated pair.
+parameters' range and over the rivals, ``PLAN_MARGIN`` below every limit) decides
+whether it may run; on those that may, each rival runs open loop from rest and stands in
+for a recording. The *separation* of two rivals is how far one misses the other's
+recording on the diagnosis' own multiple-shooting segments, after what a re-diagnosis
+would refit (``sim.discrimination``), in units of the gauges' noise, the lesser way
+round. The plan is the admissible motion with the largest separation of its
+worst-separated pair.
 
 Motions run in batches padded to one length (rest at the end), so the prediction's
-corners and each rival are one batch per chunk of motions, on all cores.
+corners and each rival are one batch per chunk of motions, on all cores; the segment
+runs are one batch per motion and rival.
 """
 
 from __future__ import annotations
 
-import itertools
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -25,9 +25,9 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from drivers.limits import DriveLimits, LimitError
-from drivers.signals import Shape, SignalSpec, plan_motion
-from sim.effects.registry import EFFECTS, EffectSpec
+from drivers.limits import DriveLimits
+from sim.discrimination import recording_of, shooting_separation
+from sim.effects.registry import EffectSpec
 from sim.envelope import (
     MotionFigures,
     Prediction,
@@ -38,40 +38,28 @@ from sim.envelope import (
     worst_of,
 )
 from sim.model import BatchResult, Model
+from sim.motions import Candidate, lengthened, motion_grid, padded
 from sim.params import StandParams
 from sim.prediction import corner_variants
 
 __all__ = [
+    "DECISIVE",
     "PLAN_MARGIN",
-    "PREDICTABLE_SLACK",
     "Candidate",
     "Noise",
     "Plan",
     "Rival",
     "Setting",
+    "as_planned",
     "motion_grid",
-    "param_steps",
+    "plannable",
+    "score",
     "search",
-    "separation",
 ]
 
 FloatArray = NDArray[np.float64]
 Clock = Callable[[], float]
 
-#: The grid [estimate]: strokes, rates and ramps spanning the drive's range coarsely.
-AMPLITUDES_MM = (10.0, 25.0, 45.0, 70.0, 90.0)
-FREQUENCIES_HZ = (0.25, 0.5, 1.0, 1.5, 2.0, 3.0, 4.0)
-RAMP_FRACTIONS = (0.1, 0.25, 0.4)
-#: Each motion lasts about this long (cycles = rate × this, at least 2), s: long enough
-#: for the weight's response to settle into its cycle, short enough to keep the search
-#: cheap; the separation is an RMS, so more cycles would not raise it.
-MOTION_S = 3.0
-DWELL_START_S, DWELL_END_S = 0.5, 1.0
-#: The largest share of slack time a planned motion may have in the worst case: with
-#: the fibre slack the weight flies, and open-loop runs of two nearly equal models part
-#: ways (the paper: "can even have the character of chaos"); what separates them there
-#: is the chaos, not the effect.
-PREDICTABLE_SLACK = 0.05
 #: How far below each limit a planned motion's worst case must stay, as a share of the
 #: limit: the range of k, c and friction covers the baseline's uncertainty, not effects
 #: the model lacks (on the other truth stand a pulley seat that jumps carried the weight
@@ -79,6 +67,10 @@ PREDICTABLE_SLACK = 0.05
 PLAN_MARGIN = 0.1
 #: Motions per batch.
 CHUNK = 24
+#: A separation of at least this many noise units tells a pair apart [estimate]: below
+#: it the rivals' outputs differ by less than the gauges' noise, and a re-diagnosis may
+#: well not settle it.
+DECISIVE = 1.0
 
 
 @dataclass(frozen=True)
@@ -98,26 +90,6 @@ class Noise:
 
 
 @dataclass(frozen=True)
-class Candidate:
-    """A motion the search considers."""
-
-    spec: SignalSpec
-    mass_kg: float
-
-    def describe(self) -> str:
-        """'a 4 Hz trapezoid of 25 mm with 8.131 kg' and the like."""
-        kind = {
-            Shape.RECTANGULAR: "rectangle",
-            Shape.TRAPEZOIDAL: "trapezoid",
-            Shape.QUASI_SINUSOIDAL: "quasi-sine",
-        }[self.spec.shape]
-        return (
-            f"a {self.spec.frequency_hz:g} Hz {kind} of {self.spec.amplitude_m * 1e3:g} mm "
-            f"with {self.mass_kg:g} kg"
-        )
-
-
-@dataclass(frozen=True)
 class Plan:
     """The search's answer.
 
@@ -131,6 +103,8 @@ class Plan:
         The chosen motion's safety prediction (worst over the range and the rivals).
     searched, admissible
         Motions simulated, and those the prediction admits.
+    options
+        The admissible motions themselves (a side-by-side check draws among them).
     complete
         False when the time budget ended the search early.
     """
@@ -141,6 +115,7 @@ class Plan:
     searched: int
     admissible: int
     complete: bool
+    options: tuple[Candidate, ...] = ()
 
     @property
     def expected_separation(self) -> float:
@@ -148,39 +123,15 @@ class Plan:
         return min(self.separations.values(), default=0.0)
 
 
-def motion_grid(limits: DriveLimits, masses_kg: Sequence[float]) -> list[Candidate]:
-    """Every grid motion the drive can make, in a fixed scattered order.
+def score(separations: dict[tuple[str, str], float]) -> tuple[int, float]:
+    """How well a motion separates: the pairs it tells apart (``DECISIVE``), then the worst.
 
-    The order is a seeded permutation, so that a search cut short by its budget has
-    still seen the whole range coarsely.
+    With several open questions (nothing named, each candidate against the baseline) a
+    test that settles most of them beats one that settles none a little better; with
+    one pair it is the separation itself.
     """
-    grid = []
-    for shape, a_mm, f_hz, mass in itertools.product(
-        Shape, AMPLITUDES_MM, FREQUENCIES_HZ, masses_kg
-    ):
-        ramps = RAMP_FRACTIONS if shape is Shape.TRAPEZOIDAL else (0.25,)
-        for ramp in ramps:
-            cycles = max(2, round(MOTION_S * f_hz))
-            spec = SignalSpec(shape, a_mm / 1e3, f_hz, cycles, ramp, DWELL_START_S, DWELL_END_S)
-            try:
-                plan_motion(spec, limits)
-            except LimitError:
-                continue
-            grid.append(Candidate(spec, mass))
-    order = np.random.default_rng(0).permutation(len(grid))
-    return [grid[i] for i in order]
-
-
-def _padded(
-    candidates: Sequence[Candidate], limits: DriveLimits, rate_hz: float
-) -> tuple[FloatArray, list[int]]:
-    """The motions' drive positions padded with rest to one length, and their lengths."""
-    xs = [plan_motion(c.spec, limits).sample(rate_hz)[1] for c in candidates]
-    n = max(x.size for x in xs)
-    out = np.zeros((len(xs), n))
-    for row, x in zip(out, xs, strict=True):
-        row[: x.size] = x
-    return out, [x.size for x in xs]
+    told = sum(sep >= DECISIVE for sep in separations.values())
+    return told, min(separations.values(), default=0.0)
 
 
 @dataclass(frozen=True)
@@ -216,11 +167,8 @@ class Setting:
 
 def _predictions(
     setting: Setting, mass: float, x: FloatArray, lengths: list[int]
-) -> tuple[list[Prediction], BatchResult]:
-    """The safety prediction of each motion (rows of x) over the spread's corners.
-
-    Also the runs themselves: motion i's corners are rows i·9 … i·9 + 8, centre first.
-    """
+) -> list[Prediction]:
+    """The safety prediction of each motion (rows of x) over the spread's corners."""
     stand = setting.nominal.with_(mass_kg=mass)
     corners = corner_variants(stand, setting.spread)
     rows = np.repeat(x, len(corners), axis=0)
@@ -238,86 +186,66 @@ def _predictions(
             for j in range(i * len(corners), (i + 1) * len(corners))
         ]
         out.append(Prediction(figs[0], worst_of(figs), len(figs)))
-    return out, res
+    return out
 
 
-def _scaled(u: FloatArray, f: FloatArray, noise: Noise) -> FloatArray:
-    """u and F stacked in noise units."""
-    return np.concatenate([u / noise.u_m, f / noise.force_n], axis=-1)
-
-
-def _nuisance(res: BatchResult, i: int, n: int, noise: Noise, corners: int) -> FloatArray:
-    """Motion i's output directions of the baseline's parameters: corners − centre, (2n, 8)."""
-    rows = slice(i * corners, (i + 1) * corners)
-    z = _scaled(res.u_m[rows, :n], res.force_n[rows, :n], noise)
-    return np.asarray((z[1:] - z[0]).T, dtype=np.float64)
-
-
-def separation(difference: FloatArray, nuisance: FloatArray) -> float:
-    """RMS of a difference of two runs (stacked u, F in noise units) beyond the nuisance.
-
-    The part a refit of the baseline's stiffness, damping and friction would absorb (the
-    least-squares projection on the corners' directions) does not count.
-    """
-    coef, *_ = np.linalg.lstsq(nuisance, difference, rcond=None)
-    rest = difference - nuisance @ coef
-    return float(np.sqrt(2.0 * np.mean(np.square(rest))))
-
-
-def param_steps(rival: Rival) -> list[dict[str, float]]:
-    """A small step of each of the rival's fitted effect parameters (a refit moves them)."""
-    steps = []
-    for spec in rival.effects:
-        values = spec.resolved()
-        for p in EFFECTS[spec.name].params:
-            if not p.fit or p.integer:
-                continue
-            v = values[p.name]
-            step = 0.05 * abs(v) if abs(v) > 1e-3 * (p.high - p.low) else 0.02 * (p.high - p.low)
-            steps.append({f"{spec.name}.{p.name}": v + step if v + step <= p.maximum else v - step})
-    return steps
-
-
-@dataclass(frozen=True)
-class _RivalRuns:
-    """A rival's runs: per motion its centre, then one per parameter step (``sets`` rows)."""
-
-    res: BatchResult
-    sets: int
-
-    def channels(self, j: int, n: int) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
-        """Motion j's recorded u, F and true u, F at the centre."""
-        r, row = self.res, j * self.sets
-        return r.u_m[row, :n], r.force_n[row, :n], r.true_u_m[row, :n], r.true_force_n[row, :n]
-
-    def directions(self, j: int, n: int, noise: Noise) -> FloatArray:
-        """Motion j's output directions of the rival's own parameters, (2n, steps)."""
-        rows = slice(j * self.sets, (j + 1) * self.sets)
-        z = _scaled(self.res.u_m[rows, :n], self.res.force_n[rows, :n], noise)
-        return np.asarray((z[1:] - z[0]).T, dtype=np.float64)
-
-
-def _rival_runs(setting: Setting, mass: float, x: FloatArray) -> dict[str, _RivalRuns]:
-    """Each rival on every motion (rows of x): at its values, and a step off each."""
+def _rival_runs(setting: Setting, mass: float, x: FloatArray) -> dict[str, BatchResult]:
+    """Each rival open loop from rest on every motion (rows of x), at the model's centre."""
     stand = setting.nominal.with_(mass_kg=mass)
     centre = corner_variants(stand, setting.spread)[0]
-    runs = {}
-    for rival in setting.rivals:
-        variants = [centre] + [{**centre, **step} for step in param_steps(rival)]
-        rows = np.repeat(x, len(variants), axis=0)
-        res = Model(stand, rival.effects).run_batch(rows, setting.rate_hz, variants * len(x))
-        runs[rival.name] = _RivalRuns(res, len(variants))
-    return runs
+    return {
+        rival.name: Model(stand, rival.effects).run_batch(x, setting.rate_hz, [centre] * len(x))
+        for rival in setting.rivals
+    }
 
 
 def _rival_figures(
-    runs: dict[str, _RivalRuns], j: int, n: int, setting: Setting
+    runs: dict[str, BatchResult], j: int, n: int, setting: Setting
 ) -> list[MotionFigures]:
-    figures = []
-    for r in runs.values():
-        _, f, true_u, true_f = r.channels(j, n)
-        figures.append(figures_of(true_f, f, true_u, setting.rate_hz, setting.rule.slack_force_n))
-    return figures
+    slack_n = setting.rule.slack_force_n
+    return [
+        figures_of(r.true_force_n[j, :n], r.force_n[j, :n], r.true_u_m[j, :n], rate, slack_n)
+        for r, rate in ((r, setting.rate_hz) for r in runs.values())
+    ]
+
+
+def _separations(
+    setting: Setting, stand: StandParams, runs: dict[str, BatchResult], j: int, x: FloatArray
+) -> dict[tuple[str, str], float]:
+    """Each pair's separation on motion j, on the diagnosis' segments, the lesser way round."""
+    n = x.size
+    noise = setting.noise
+    recordings = {
+        name: recording_of(name, x, r.u_m[j, :n], r.force_n[j, :n], setting.rate_hz,
+                           stand.mass_kg, (noise.u_m, noise.force_n))
+        for name, r in runs.items()
+    }  # fmt: skip
+    models = {rival.name: rival.effects for rival in setting.rivals}
+    misses: dict[tuple[str, str], float] = {}
+
+    def miss(truth: str, model: str) -> float:
+        if (truth, model) not in misses:
+            misses[(truth, model)] = shooting_separation(
+                recordings[truth], stand, models[truth], models[model], noise.u_m, noise.force_n
+            ).against_floor
+        return misses[(truth, model)]
+
+    def nested(inner: str, outer: str) -> bool:
+        return {e.name for e in models[inner]} < {e.name for e in models[outer]}
+
+    # A model nested in its rival (the baseline in "an effect against none") is not
+    # judged as the rival's miss of it: the rival's own parameters can switch its effect
+    # off, and the diagnosis names an effect only on evidence of a gain over the smaller
+    # model. So only the smaller model's miss of the larger one's recording counts.
+    return {
+        (a, b): miss(a, b) if nested(b, a) else miss(b, a) if nested(a, b)
+        else min(miss(a, b), miss(b, a))
+        for a, b in setting.pairs
+    }  # fmt: skip
+
+
+#: A judged motion: its score, itself, each pair's separation, its safety prediction.
+_Judged = tuple[tuple[int, float], Candidate, dict[tuple[str, str], float], Prediction]
 
 
 def search(
@@ -325,8 +253,9 @@ def search(
 ) -> Plan:
     """Search the grid (in its order) until done or the budget is spent."""
     started = clock()
-    best: tuple[float, Candidate, dict[tuple[str, str], float], Prediction] | None = None
-    searched = admissible = 0
+    best: _Judged | None = None
+    searched = 0
+    options: list[Candidate] = []
     complete = True
     for k in range(0, len(grid), CHUNK):
         if k and clock() - started > budget_s:  # the first chunk always runs
@@ -337,24 +266,43 @@ def search(
             group = [c for c in chunk if c.mass_kg == mass]
             searched += len(group)
             for found in _judge(setting, mass, group):
-                admissible += 1
+                options.append(found[1])
                 if best is None or found[0] > best[0]:
                     best = found
     if best is None:
-        return Plan(None, {}, None, searched, admissible, complete)
-    return Plan(best[1], best[2], best[3], searched, admissible, complete)
+        return Plan(None, {}, None, searched, 0, complete)
+    best = _as_planned(setting, best)
+    return Plan(best[1], best[2], best[3], searched, len(options), complete, tuple(options))
 
 
-def _judge(
-    setting: Setting, mass: float, group: Sequence[Candidate]
-) -> list[tuple[float, Candidate, dict[tuple[str, str], float], Prediction]]:
+def _as_planned(setting: Setting, found: _Judged) -> _Judged:
+    """The motion lengthened to the planned test's length, if that too is admissible."""
+    longer = lengthened(found[1], setting.limits)
+    judged = _judge(setting, longer.mass_kg, [longer])
+    return judged[0] if judged else found
+
+
+def as_planned(setting: Setting, candidate: Candidate) -> Candidate:
+    """A searched motion as a test is planned: lengthened (``lengthened``) if still admissible.
+
+    The search judges short motions; the plan runs the chosen one longer, and a check that
+    draws a motion among ``Plan.options`` runs it the same way.
+    """
+    longer = lengthened(candidate, setting.limits)
+    return longer if _judge(setting, longer.mass_kg, [longer]) else candidate
+
+
+def _judge(setting: Setting, mass: float, group: Sequence[Candidate]) -> list[_Judged]:
     """The group's admissible motions: (score, motion, separations, prediction) each."""
-    x, lengths = _padded(group, setting.limits, setting.rate_hz)
-    predictions, corners = _predictions(setting, mass, x, lengths)
+    x, lengths = padded(group, setting.limits, setting.rate_hz)
+    predictions = _predictions(setting, mass, x, lengths)
     ok = [i for i, p in enumerate(predictions) if _admissible(p, setting)]
     if not ok:
         return []
     runs = _rival_runs(setting, mass, x[ok])
+    stand = setting.nominal.with_(mass_kg=mass)
+    centre = corner_variants(stand, setting.spread)[0]
+    fitted = stand.with_(**centre)
     found = []
     for j, i in enumerate(ok):
         n, pred = lengths[i], predictions[i]
@@ -362,19 +310,21 @@ def _judge(
         pred = Prediction(pred.nominal, worst_of([pred.worst, *rivals]), pred.runs + len(rivals))
         if not _admissible(pred, setting):
             continue
-        baseline = _nuisance(corners, i, n, setting.noise, predictions[i].runs)
-        scaled = {name: _scaled(*r.channels(j, n)[:2], setting.noise) for name, r in runs.items()}
-        seps = {}
-        for a, b in setting.pairs:
-            own = [runs[a].directions(j, n, setting.noise), runs[b].directions(j, n, setting.noise)]
-            seps[(a, b)] = separation(scaled[a] - scaled[b], np.hstack([baseline, *own]))
-        found.append((min(seps.values()), group[i], seps, pred))
+        seps = _separations(setting, fitted, runs, j, x[i, :n])
+        found.append((score(seps), group[i], seps, pred))
     return found
 
 
+def plannable(prediction: Prediction, envelope: StandEnvelope, rule: SlackRule) -> bool:
+    """Whether the planner may choose a motion so predicted: ``PLAN_MARGIN`` inside every limit.
+
+    Slack is allowed as far as the slack e-stop's limit (with the margin) allows: the
+    diagnosis restarts its segments after every slack episode (``sim.discrimination``),
+    so a snatch is no longer unpredictable chaos to it, and snatches are what excite a
+    gauge's or a channel's high-frequency differences.
+    """
+    return min(prediction.margins(envelope, rule).values()) >= PLAN_MARGIN
+
+
 def _admissible(prediction: Prediction, setting: Setting) -> bool:
-    """Within ``PLAN_MARGIN`` of the limits, and predictable open loop (little slack)."""
-    margins = prediction.margins(setting.envelope, setting.rule)
-    if min(margins.values()) < PLAN_MARGIN:
-        return False
-    return prediction.worst.slack_share <= PREDICTABLE_SLACK
+    return plannable(prediction, setting.envelope, setting.rule)

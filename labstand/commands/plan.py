@@ -22,7 +22,7 @@ if TYPE_CHECKING:  # imported where they run: `plan --help` loads no numba
 
 __all__ = ["diagnosed", "noise_of", "register", "run", "traces_of"]
 
-#: The search's default time budget, s (the grid takes ≈ 15–25 s on 2 cores).
+#: The search's default time budget, s (the grid took 34 s on 2 heavily shared cores).
 BUDGET_S = 40.0
 
 

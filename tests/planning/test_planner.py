@@ -7,18 +7,24 @@ import pytest
 
 from drivers.signals import Shape, plan_motion
 from sim.config import default_config
+from sim.discrimination import recording_of
 from sim.effects import EffectSpec
 from sim.envelope import NOMINAL_SPREAD, SlackRule
 from sim.model import Model
+from sim.motions import MOTION_S, PLAN_CYCLES, PLAN_S, lengthened
 from sim.planner import (
-    PREDICTABLE_SLACK,
+    DECISIVE,
+    PLAN_MARGIN,
     Candidate,
     Noise,
+    Plan,
     Rival,
     Setting,
+    as_planned,
     motion_grid,
+    plannable,
+    score,
     search,
-    separation,
 )
 from sim.prediction import predict
 
@@ -61,62 +67,107 @@ def test_the_grid_holds_only_motions_the_drive_can_make() -> None:
     assert grid == motion_grid(config.drive, [3.096, 8.131])  # the same order every time
 
 
-def test_separation_counts_only_what_a_refit_would_not_absorb() -> None:
-    rng = np.random.default_rng(1)
-    nuisance = rng.normal(size=(400, 3))
-    assert separation(np.zeros(400), nuisance) == 0.0
-    along = nuisance @ np.array([2.0, -1.0, 0.5])
-    assert separation(along, nuisance) == pytest.approx(0.0, abs=1e-9)
-    across = rng.normal(size=400)
-    across -= nuisance @ np.linalg.lstsq(nuisance, across, rcond=None)[0]
-    expected = np.sqrt(2.0 * np.mean(across**2))
-    assert separation(across + along, nuisance) == pytest.approx(expected)
-
-
 def _independent_separation(candidate: Candidate) -> float:
-    """The pair's separation on one motion, run by run (each rival, each corner)."""
+    """The pair's separation on one motion, run by run: the skew's noisy recording, the
+    baseline's segment runs from it one parameter set at a time, the least-squares
+    remainder, against what the skew model itself misses there (noise and restarts)."""
     config = default_config()
-    x = plan_motion(candidate.spec, config.drive).sample(config.sample_rate_hz)[1]
+    rate = config.sample_rate_hz
+    x = plan_motion(candidate.spec, config.drive).sample(rate)[1]
     stand = config.stand_params("final", candidate.mass_kg)
+    truth = Model(stand, (SKEW,)).run(x, rate)
+    noise = (NOISE.u_m, NOISE.force_n)
+    recording = recording_of("skew", x, truth.u_m, truth.force_n, rate, stand.mass_kg, noise)
+    seg = recording.segments
 
     def scaled(model: Model) -> np.ndarray:
-        r = model.run(x, config.sample_rate_hz)
-        return np.concatenate([r.u_m / NOISE.u_m, r.force_n / NOISE.force_n])
+        u, f = model.run_segments(recording.x_m, rate, seg.restarts)
+        return np.concatenate([seg.assemble(u)[0] / NOISE.u_m, seg.assemble(f)[0] / NOISE.force_n])
 
-    corners = [
-        scaled(Model(stand.with_(
-            stiffness_n_m=stand.stiffness_n_m * k, damping_n_s_m=stand.damping_n_s_m * c,
-            friction_scale=stand.friction_scale * f,
-        )))
-        for k, c, f in NOMINAL_SPREAD.corners()
-    ]  # fmt: skip
-    skew = scaled(Model(stand, (SKEW,)))
-    # what a refit of the skew's own parameters moves: a small step of each (5 % of the
-    # value, or 2 % of the typical range ±3 ms where the value is 0)
-    steps = [{"force_skew_s": 0.0021}, {"force_skew_s": 0.002, "displacement_skew_s": 1.2e-4}]
-    own = [scaled(Model(stand, (EffectSpec("channel_time_skew", p),))) - skew for p in steps]
-    nuisance = np.column_stack([*(np.array(corners[1:]) - corners[0]), *own])
-    return separation(skew - scaled(Model(stand)), nuisance)
+    target = scaled(Model(stand, (SKEW,)))
+    baseline = scaled(Model(stand))
+    # a refit of the baseline's stiffness (5 %), damping and friction (10 %) absorbs these
+    steps = [
+        scaled(Model(stand.with_(stiffness_n_m=stand.stiffness_n_m * 1.05))),
+        scaled(Model(stand.with_(damping_n_s_m=stand.damping_n_s_m * 1.1))),
+        scaled(Model(stand.with_(friction_scale=stand.friction_scale * 1.1))),
+    ]
+    directions = np.column_stack([v - baseline for v in steps])
+    coef, *_ = np.linalg.lstsq(directions, target - baseline, rcond=None)
+    rest = target - baseline - directions @ coef
+    data = np.concatenate([recording.u_m / NOISE.u_m, recording.force_n / NOISE.force_n])
+    n, held_out = x.size, recording.test
+    product = 1.0
+    for c in (0, 1):  # u, then F: each channel's miss against its own floor, held out
+        part = slice(c * n, (c + 1) * n)
+        miss = np.sqrt(np.mean(rest[part][held_out] ** 2))
+        floor = np.sqrt(np.mean((data[part] - target[part])[held_out] ** 2))
+        product *= 1.0 + (miss / max(floor, 1.0)) ** 2
+    return float(np.sqrt(product - 1.0))
 
 
 def test_the_plan_is_admissible_and_its_separation_is_what_the_rivals_do() -> None:
     setting = _setting()
     config = default_config()
-    grid = motion_grid(config.drive, [8.131])[:48]
+    grid = motion_grid(config.drive, [3.096])[:48]
     plan = search(setting, grid, budget_s=600.0)
     assert plan.complete and plan.searched == 48 and plan.best is not None
-    assert 0 < plan.admissible < 48
+    assert 0 < plan.admissible < 48 and len(plan.options) == plan.admissible
     pred = plan.prediction
-    assert pred is not None and not pred.breaches(config.envelope, RULE)
-    assert pred.worst.slack_share <= PREDICTABLE_SLACK
-    # the chosen motion again, run by run: the search's batches found the same
+    assert pred is not None and plannable(pred, config.envelope, RULE)
+    # the chosen motion again, run by run: the search's batches found the same (the
+    # baseline nested in the skew model: only its miss of the skew's recording counts,
+    # against the skew's own miss of it)
     expected = _independent_separation(plan.best)
     assert plan.separations[("skew", "none")] == pytest.approx(expected, rel=1e-6)
-    assert expected > 1.0  # a 2 ms delay of F is seen, beyond what a refit absorbs
-    # and it is the best the grid allows: at least the slowest quasi-sine's (admissible)
-    sines = [c for c in grid if c.spec.shape is Shape.QUASI_SINUSOIDAL]
-    slow = min(sines, key=lambda c: c.spec.frequency_hz * c.spec.amplitude_m)
-    assert plan.expected_separation >= _independent_separation(slow)
+    assert expected > DECISIVE  # a 2 ms delay of F is seen, beyond what a refit absorbs
+    # the search judged it short, and it is the best of the admissible motions so judged
+    short = next(o for o in plan.options if lengthened(o, config.drive) == plan.best)
+    for other in plan.options[:6]:
+        assert _independent_separation(short) >= _independent_separation(other) - 1e-9
+
+
+def test_the_planned_test_runs_longer_than_the_motions_searched() -> None:
+    config = default_config()
+    grid = motion_grid(config.drive, [3.096, 8.131])[:24]
+    assert all(c.spec.cycles == max(2, round(MOTION_S * c.spec.frequency_hz)) for c in grid)
+    plan = search(_setting(), grid, budget_s=600.0)
+    assert plan.best is not None and plan.best not in grid
+    f = plan.best.spec.frequency_hz
+    assert plan.best.spec.cycles == max(PLAN_CYCLES, round(PLAN_S * f))  # ≥ 2 held-out cycles
+    # the longer motion's own prediction is what the plan carries, within the margins
+    x = plan_motion(plan.best.spec, config.drive).sample(config.sample_rate_hz)[1]
+    stand = config.stand_params("final", plan.best.mass_kg)
+    for effects in ((), (SKEW,)):
+        p = predict(stand, effects, x, config.sample_rate_hz, NOMINAL_SPREAD, RULE.slack_force_n)
+        assert plannable(p, config.envelope, RULE)
+    assert plan.prediction is not None
+    assert plan.prediction.worst.weight_travel_m >= p.worst.weight_travel_m - 1e-12
+    # a drawn option runs as long as the plan (if that is admissible too)
+    drawn = as_planned(_setting(), plan.options[0])
+    assert drawn.spec.cycles >= plan.options[0].spec.cycles
+
+
+def test_motions_with_brief_slack_are_plannable_within_the_margins() -> None:
+    # the diagnosis restarts after slack: a snatching motion is no longer refused as chaos
+    config = default_config()
+    plan = search(_setting(), motion_grid(config.drive, [3.096])[:48], budget_s=600.0)
+    slack = []
+    for c in plan.options:
+        x = plan_motion(c.spec, config.drive).sample(config.sample_rate_hz)[1]
+        stand = config.stand_params("final", c.mass_kg)
+        p = predict(stand, (SKEW,), x, config.sample_rate_hz, NOMINAL_SPREAD, RULE.slack_force_n)
+        assert p.worst.longest_slack_s <= (1 - PLAN_MARGIN) * RULE.slack_max_s + 1e-9
+        slack.append(p.worst.slack_share)
+    assert max(slack) > 0.05  # the old rule (at most 5 % slack) would have refused these
+
+
+def test_the_score_counts_pairs_told_apart_before_the_worst() -> None:
+    assert score({("a", "none"): 3.0, ("b", "none"): 0.2}) == (1, 0.2)
+    many = {("a", "none"): 1.5, ("b", "none"): 1.1, ("c", "none"): 0.1}
+    few = {("a", "none"): 9.0, ("b", "none"): 0.5, ("c", "none"): 0.4}
+    assert score(many) > score(few)  # two questions settled beat one settled by more
+    assert score({("a", "b"): 0.9}) > score({("a", "b"): 0.8})
 
 
 def test_the_planned_motion_passes_the_run_s_own_prediction() -> None:
@@ -136,3 +187,32 @@ def test_a_spent_budget_ends_the_search_with_what_it_has() -> None:
                   clock=lambda: float(next(ticks)))  # fmt: skip
     assert not plan.complete
     assert plan.searched == 24  # one chunk, then the clock said the budget was spent
+
+
+def test_the_line_says_how_many_pairs_and_whether_the_worst_is_told_apart() -> None:
+    from labstand.fitted import FittedStand
+    from labstand.planning import PlanAnswer
+
+    config = default_config()
+    best = motion_grid(config.drive, [8.131])[0]
+    x = plan_motion(best.spec, config.drive).sample(config.sample_rate_hz)[1]
+    stand = config.stand_params("final", 8.131)
+    pred = predict(stand, (), x, config.sample_rate_hz, NOMINAL_SPREAD, RULE.slack_force_n)
+    fitted = FittedStand("d.json", (1.0, 1.0, 1.0), {}, ())
+
+    def line(separations: dict[tuple[str, str], float]) -> str:
+        plan = Plan(best, separations, pred, 10, 5, True)
+        return PlanAnswer(plan, fitted, config, RULE, NOISE, 40.0).line()
+
+    one = line({("gauge", "skew"): 0.3})
+    assert f"{best.describe()} separates gauge from skew by 0.3 noise units only" in one
+    assert "(below 1: hardly told apart)" in one
+    many = line({("a", "none"): 2.5, ("b", "none"): 1.2, ("c", "none"): 0.4})
+    assert "tells 2 of 3 rival pairs apart; the worst, c from none, by 0.4 noise units" in many
+    assert "hardly told apart" not in line({("a", "none"): 2.5, ("b", "none"): 1.2})
+
+
+def test_the_command_and_the_search_agree_on_what_tells_a_pair_apart() -> None:
+    import labstand.planning
+
+    assert labstand.planning.DECISIVE == DECISIVE  # the CLI keeps a copy to load no numba

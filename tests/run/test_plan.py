@@ -59,13 +59,9 @@ def test_the_rivals_a_diagnosis_leaves() -> None:
         ("force_gauge_dynamics", "channel_time_skew"),
         ("force_gauge_dynamics", "none"),
     ]
-    # nothing named: the two best against the baseline and each other
+    # nothing named: each of the best against the baseline (which one, if any, is there?)
     _, pairs = rivals_of(fitted_from_dict(_diagnosis(effects=[], effect="none"), where))
-    assert pairs == [
-        ("force_gauge_dynamics", "none"),
-        ("force_gauge_dynamics", "channel_time_skew"),
-        ("channel_time_skew", "none"),
-    ]
+    assert pairs == [("force_gauge_dynamics", "none"), ("channel_time_skew", "none")]
     with pytest.raises(CommandError, match="no rival explanations to separate"):
         rivals_of(fitted_from_dict(_diagnosis(effects=[], ranking=[]), where))
 
@@ -84,12 +80,14 @@ def test_plan_then_run_the_plan(labstand: Callable[..., Outcome], tmp_path: Path
     assert plan["why"] == line and plan["searched"] >= plan["admissible"] > 0
     assert plan["separates"][0]["rivals"] == ["force_gauge_dynamics", "channel_time_skew"]
     assert plan["expected_separation"] == plan["separates"][0]["separation"] > 0
-    # a 1.1 ms skew and a 222 Hz gauge delay the force alike: below the noise everywhere
-    assert plan["decisive"] is False and plan["expected_separation"] < 1.0
-    assert "noise units only (below 1: hardly told apart)" in line
+    # decisive is the separation against 1 noise unit, and the line says so either way
+    # (a 1.1 ms skew and a 222 Hz gauge: 0.6 at the simulated gauges' 0.1 N, the
+    # noise without recordings; several units at the demo's recorded 0.02 N)
+    assert plan["decisive"] is (plan["expected_separation"] >= 1.0)
+    assert ("only (below 1: hardly told apart)" in line) is not plan["decisive"]
     predicted = plan["predicted"]
-    assert predicted["weight_travel_mm"] < 120 and predicted["peak_tension_n"] < 400
-    assert predicted["longest_slack_s"] < 0.25 and predicted["slack_share"] <= 0.05
+    assert predicted["weight_travel_mm"] < 0.9 * 120 and predicted["peak_tension_n"] < 0.9 * 400
+    assert predicted["longest_slack_s"] < 0.9 * 0.25
     assert all(m > 0 for m in predicted["margins"].values())
     assert plan["signal"]["mass_kg"] == 8.131
 
