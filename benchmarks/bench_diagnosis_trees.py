@@ -25,6 +25,7 @@ import subprocess
 import sys
 import time
 from pathlib import Path
+from typing import Any
 
 HERE = Path(__file__).resolve().parent.parent
 CAMPAIGNS = (("none", 3.096), ("fibre_viscoelastic", 8.131), ("stick_slip_friction", 3.096))
@@ -33,24 +34,35 @@ EMPTY_SURE = {"baseline_intervals": {}, "baseline_reaches_bound": [], "gap_closu
               "baseline_consistency": {}}  # fmt: skip
 
 
-def measure(truth: str, mass: float) -> dict[str, object]:
-    """Diagnose the campaign twice in this process (its tree on sys.path); time the second."""
+def campaign(truth: str, mass: float) -> tuple[list[Any], Any]:
+    """The campaign's traces (seed 1, moderate recordings) and nominal, in this tree."""
     import importlib
 
     try:
         check = importlib.import_module("sim.checks.check")
-        pipeline = importlib.import_module("sim.identify.pipeline")
-        pipeline.how_sure = lambda *_a, **_k: dict(EMPTY_SURE)  # type: ignore[attr-defined]
     except ImportError:  # the tree before the refactor
         check = importlib.import_module("sim.identify.check")
     from sim.config import load_config
-    from sim.identify import diagnose
 
     stand = load_config(None)
     spec = check.CaseSpec(truth, mass, 0, 1)
     traces, _, _ = check.make_campaign(stand, truth, mass, spec.rng(),
                                        check.recording_set("moderate", stand))  # fmt: skip
-    nominal = stand.stand_params("final", mass)
+    return traces, stand.stand_params("final", mass)
+
+
+def measure(truth: str, mass: float) -> dict[str, object]:
+    """Diagnose the campaign twice in this process (its tree on sys.path); time the second."""
+    import importlib
+
+    from sim.identify import diagnose
+
+    try:
+        pipeline = importlib.import_module("sim.identify.pipeline")
+        pipeline.how_sure = lambda *_a, **_k: dict(EMPTY_SURE)  # type: ignore[attr-defined]
+    except ImportError:  # the tree before the refactor
+        pass
+    traces, nominal = campaign(truth, mass)
     diagnose(traces, nominal)
     wall, cpu = time.perf_counter(), time.process_time()
     d = diagnose(traces, nominal)
@@ -61,26 +73,17 @@ def measure(truth: str, mass: float) -> dict[str, object]:
 def objective(truth: str, mass: float) -> dict[str, object]:
     """Best CPU time of the candidate's objective over a batch of 8 sets (this tree)."""
     import dataclasses
-    import importlib
 
     import numpy as np
 
-    try:
-        check = importlib.import_module("sim.checks.check")
-    except ImportError:  # the tree before the refactor
-        check = importlib.import_module("sim.identify.check")
-    from sim.config import load_config
     from sim.identify.fitting import Candidate, Objective
     from sim.identify.shooting import dial_slope
 
-    stand = load_config(None)
-    spec = check.CaseSpec(truth, mass, 0, 1)
-    traces, _, _ = check.make_campaign(stand, truth, mass, spec.rng(),
-                                       check.recording_set("moderate", stand))  # fmt: skip
+    traces, nominal = campaign(truth, mass)
     slope = dial_slope(traces)
     traces = [dataclasses.replace(tr, dial_slope=slope) for tr in traces]
     cand = Candidate.build() if truth == "none" else Candidate.build(truth)
-    obj = Objective(cand, traces, stand.stand_params("final", mass), 4)
+    obj = Objective(cand, traces, nominal, 4)
     middle = {p.name: 0.5 * (p.low + p.high) for p in cand.params}
     z = cand.internal({**middle, "stiffness_scale": 1.0, "damping_scale": 1.0})
     zs = np.stack([z] * 8)

@@ -5,7 +5,6 @@ changes no number, a mistake in it is one line, and a diagnosis names it."""
 from __future__ import annotations
 
 import dataclasses
-import importlib
 from collections.abc import Iterator
 from typing import Any
 
@@ -13,13 +12,13 @@ import numpy as np
 import pytest
 
 from drivers.signals import Shape, SignalSpec, plan_motion
-from sim.checks.check import SMALL_CAMPAIGN, make_campaign
 from sim.config import StandConfig
 from sim.effects import EFFECTS, EffectError, EffectSpec, register, unregister
 from sim.effects.info import EffectInfo
 from sim.model import Model, Restarts
 from sim.physics import compose, gauges, layout, runs
 from tests.effects import force_gain_drift
+from tests.effects.blind import named_blind
 
 NAME = "force_gain_drift"
 MASS = 8.131
@@ -155,14 +154,7 @@ def test_a_mistake_in_its_file_is_refused_in_one_line() -> None:
 def test_a_diagnosis_names_it_among_every_effect(
     stand: StandConfig, drift: EffectInfo, mass: float, seed: int
 ) -> None:
-    # A campaign drawn as the check draws one, diagnosed blind against every effect.
-    traces, _, truth = make_campaign(
-        stand, NAME, mass, np.random.default_rng(seed), SMALL_CAMPAIGN, open_loop_oracle=True
-    )
-    diagnose = importlib.import_module("sim.identify.pipeline").diagnose
-    result = diagnose(traces, stand.stand_params("final", mass))
-    assert len(result.ranking) == len(EFFECTS)
-    assert result.effect == NAME, [(r.effect, r.p_value) for r in result.ranking]
+    result, truth = named_blind(stand, NAME, mass, seed)
     fitted = result.effects[0].params["drift_per_s"]
     assert fitted == pytest.approx(truth["drift_per_s"], rel=0.05)
     assert result.effects[0].closure > 0.5  # most of the gap: the rest is the gauges' noise

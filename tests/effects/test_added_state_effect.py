@@ -14,7 +14,6 @@ import numpy as np
 import pytest
 
 from drivers.signals import Shape, SignalSpec, plan_motion
-from sim.checks.check import SMALL_CAMPAIGN, make_campaign
 from sim.config import StandConfig
 from sim.effects import EFFECTS, EffectError, EffectSpec, register, unregister
 from sim.effects.info import EffectInfo
@@ -22,6 +21,7 @@ from sim.model import Model
 from sim.physics import compose, layout
 from sim.physics.runs import friction_arrays, parameter_row, simulate_rows
 from tests.effects import weight_latch
+from tests.effects.blind import named_blind
 
 NAME = "weight_latch"
 MASS = 8.131
@@ -162,15 +162,7 @@ def test_off_it_changes_no_number(stand: StandConfig, latch: EffectInfo) -> None
 def test_a_diagnosis_names_it_among_every_effect(
     stand: StandConfig, latch: EffectInfo, mass: float, seed: int
 ) -> None:
-    # A campaign drawn as the check draws one (a "real" stand, the effect's parameters,
-    # the gauges' noise), diagnosed blind against every registered effect.
-    traces, _, truth = make_campaign(
-        stand, NAME, mass, np.random.default_rng(seed), SMALL_CAMPAIGN, open_loop_oracle=True
-    )
-    diagnose = importlib.import_module("sim.identify.pipeline").diagnose
-    result = diagnose(traces, stand.stand_params("final", mass))
-    assert len(result.ranking) == len(EFFECTS)
-    assert result.effect == NAME, [(r.effect, r.p_value) for r in result.ranking]
+    result, truth = named_blind(stand, NAME, mass, seed)
     fitted = result.effects[0].params
     assert fitted["force_n"] == pytest.approx(truth["force_n"], rel=0.05)
     assert fitted["tau_s"] == pytest.approx(truth["tau_s"], rel=0.15)
