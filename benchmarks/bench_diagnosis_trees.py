@@ -116,7 +116,12 @@ def main() -> None:
     parser.add_argument("--before", type=Path, required=True, help="the other source tree")
     parser.add_argument("--rounds", type=int, default=2)
     parser.add_argument("--objective", action="store_true", help="time the objective alone")
+    parser.add_argument("--only", help="one campaign, TRUTH@KG (default: the three)")
     args = parser.parse_args()
+    chosen = CAMPAIGNS
+    if args.only:
+        truth, kg = args.only.split("@")
+        chosen = ((truth, float(kg)),)
     mode = "--objective-child" if args.objective else "--child"
 
     def fmt(seconds: object) -> str:
@@ -126,7 +131,7 @@ def main() -> None:
     trees = {"before": args.before.resolve(), "now": HERE}
     best: dict[tuple[str, str], dict[str, object]] = {}
     for r in range(args.rounds):
-        for truth, mass in CAMPAIGNS:
+        for truth, mass in chosen:
             for label, tree in trees.items():
                 got = child(tree, truth, mass, mode)
                 key = (f"{truth} {mass:g} kg", label)
@@ -144,7 +149,7 @@ def main() -> None:
                       f"{fmt(got['cpu'])} CPU, named {got['named']}", flush=True)  # fmt: skip
     print("| campaign | wall, before | wall, now | CPU, before | CPU, now | same answer |")
     print("|---|---|---|---|---|---|")
-    for truth, mass in CAMPAIGNS:
+    for truth, mass in chosen:
         name = f"{truth} {mass:g} kg"
         b, n = best[(name, "before")], best[(name, "now")]
         print(
