@@ -106,10 +106,10 @@ def test_a_second_effect_starts_where_its_refit_alone_ended(
     starts: dict[str, list[dict[str, float]]] = {}
     refit = naming.refit
 
-    def spy(candidate, traces, nominal, start_from, extra=()):  # type: ignore[no-untyped-def]
+    def spy(candidate, traces, nominal, start_from, extra=(), data=()):  # type: ignore[no-untyped-def]
         if len(candidate.effects) == 2:
             starts[candidate.effects[1]] = list(extra)
-        return refit(candidate, traces, nominal, start_from, extra)
+        return refit(candidate, traces, nominal, start_from, extra, data)
 
     monkeypatch.setattr(naming, "refit", spy)
     result = _gauge_and_pulley(stand)
