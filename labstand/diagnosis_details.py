@@ -48,7 +48,7 @@ def remainder_section(result: Diagnosis, plotted: bool) -> str:
     rem = result.remainder
     if rem is None:
         return f'<h2 id="remainder">What remains</h2><p>{NOT_COMPUTED}.</p>'
-    state = "beyond the noise" if rem.beyond_noise else "within what the noise allows"
+    state = html.escape(rem.state)
     rows = "".join(
         f"<tr><td>{html.escape(s.kind)}</td><td>{html.escape(s.channel)}</td>"
         f"<td>{s.closes:.0%}</td><td>{s.p_family:.2g}</td><td>{'yes' if s.passes else 'no'}</td>"

@@ -110,7 +110,7 @@ def _which(result: Diagnosis) -> str:
         )
     rem = result.remainder
     if rem is not None:
-        state = "beyond the noise" if rem.beyond_noise else "within what the noise allows"
+        state = html.escape(rem.state)
         parts.append(
             f"<li>What remains is {state} (family p = {number(rem.p_value, 2)}): "
             f'<a href="#remainder">details</a>.</li>'

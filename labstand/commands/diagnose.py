@@ -178,7 +178,7 @@ def _print_summary(result: Diagnosis, report: Path | None) -> None:
         print(f"  {effect}: passed its test but did no better than a {kind} term (not named)")
     rem = result.remainder
     if rem is not None:
-        state = "beyond the noise" if rem.beyond_noise else "within what the noise allows"
+        state = rem.state
         print(
             f"Remainder: {state} (p = {rem.p_value:.2g}); held-out error {rem.excess:.2f} × "
             f"noise, {rem.share_of_gap:.0%} of the baseline's gap"

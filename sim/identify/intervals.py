@@ -16,7 +16,9 @@ measured states pull the damping by several times its standard error. A parametr
 bootstrap (``estimator_spread``: the fit repeated on recordings the fitted model would
 make, ``BIAS_REPLICATES`` of them) measures both; the interval is centred on the
 bias-corrected value, as wide as the larger spread (plus the bias estimate's own
-uncertainty), and holds the fitted value.
+uncertainty), and holds the fitted value. Six replicates know their spread only to a
+quarter or so: its Student t has the combined error's Welch–Satterthwaite degrees of
+freedom (``combined_error``), not the blocks'.
 
 Intervals are built in the optimiser's coordinates (log for the scales, so they are
 asymmetric in natural units), cut at the physical range and marked where they reach
@@ -33,7 +35,6 @@ no refit: the uncertainty of *how far* the gap shrinks given the fitted models.
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -44,6 +45,7 @@ from scipy import stats
 
 from sim.identify.fitting import Candidate, Objective, fit, scored_samples
 from sim.identify.heldout import BLOCK_S, Outputs, _noise_scale, held_out_blocks
+from sim.identify.replicates import replicate_traces
 from sim.identify.report import Intervals
 from sim.identify.traces import Trace
 from sim.params import StandParams
@@ -56,7 +58,7 @@ PARAMETER_METHOD = (
     "parameters: Gauss–Newton linearisation (secants over the interval) with a "
     "cluster-robust sandwich covariance over 0.25 s training blocks, Student t on "
     "blocks − 1 degrees of freedom, bias-corrected and widened by a parametric bootstrap "
-    "of the fit"
+    "of the fit (Welch–Satterthwaite degrees of freedom for its few replicates)"
 )
 GAP_METHOD = "gap and closure: bootstrap over 0.25 s held-out blocks within each recording"
 BOOTSTRAP_ROUNDS = 1000
@@ -117,6 +119,22 @@ def sandwich_covariance(
     return bread @ meat @ bread, g
 
 
+def combined_error(se: float, se_dof: float, spread: float, replicates: int) -> tuple[float, float]:
+    """The sandwich's or the bootstrap's error (the larger) and the bias estimate's.
+
+    Returns the combined standard error and its Welch–Satterthwaite degrees of freedom:
+    a spread from a few replicates is itself uncertain (six give five degrees of
+    freedom, a Student t of 2.57 rather than 1.97), which the interval must carry.
+    """
+    wider, wider_dof = (spread, replicates - 1.0) if spread > se else (se, se_dof)
+    parts = ((wider**2, wider_dof), (spread**2 / replicates, replicates - 1.0))
+    total = sum(v for v, _ in parts)
+    if total <= 0.0:
+        return 0.0, se_dof
+    dof = total**2 / sum(v**2 / max(d, 1.0) for v, d in parts)
+    return math.sqrt(total), dof
+
+
 def parameter_intervals(
     candidate: Candidate,
     values: dict[str, float],
@@ -174,56 +192,22 @@ def parameter_intervals(
         zk = p.clipped(values[p.name])
         centre = zk
         shift = shifts.get(p.name)
+        t_k = t
         if shift is not None and shift.size > 1:
             # Bias-corrected, and as wide as the larger of the two spreads plus the
             # bias estimate's own uncertainty; the fitted value stays inside.
             spread = float(np.std(shift, ddof=1))
             centre = zk - float(np.mean(shift))
-            se = math.sqrt(max(se, spread) ** 2 + spread**2 / shift.size)
+            se, dof = combined_error(se, max(clusters - 1, 1), spread, shift.size)
+            t_k = float(stats.t.ppf(0.5 + level / 2, dof))
         lo, hi = p.bounds()
-        z_lo = max(min(centre - t * se, zk), lo)
-        z_hi = min(max(centre + t * se, zk), hi)
+        z_lo = max(min(centre - t_k * se, zk), lo)
+        z_hi = min(max(centre + t_k * se, zk), hi)
         out.internal_se[p.name] = se
         out.intervals[p.name] = (p.to_natural(z_lo), p.to_natural(z_hi))
         edge = 2e-3 * (hi - lo)
         if z_lo <= lo + edge or z_hi >= hi - edge:
             out.reaches_bound.append(p.name)
-    return out
-
-
-def replicate_traces(
-    candidate: Candidate,
-    values: dict[str, float],
-    traces: Sequence[Trace],
-    nominal: StandParams,
-    rng: np.random.Generator,
-    replicates: int,
-) -> list[list[Trace]]:
-    """Recordings the fitted model would make: its outputs plus each gauge's noise.
-
-    The fitted model runs open loop on each recording's drive; every replicate adds new
-    white noise at the recording's rest noise, keeps its lost samples, cycles and the
-    held-out split, and the campaign's dial gauge scale.
-    """
-    runs = []
-    for tr in traces:
-        model = candidate.model(nominal, tr.mass_kg)
-        res = model.run_batch(tr.x_m, tr.rate_hz, [candidate.variant(nominal, values)])
-        runs.append((res.u_m[0] - res.u_m[0, 0], res.force_n[0]))
-    out = []
-    for _ in range(replicates):
-        drawn = []
-        for tr, (u, f) in zip(traces, runs, strict=True):
-            u_r = u + rng.normal(0.0, tr.noise_u_m, u.size)
-            f_r = f + rng.normal(0.0, tr.noise_force_n, f.size)
-            drawn.append(
-                dataclasses.replace(
-                    tr,
-                    u_m=np.where(tr.present, u_r, np.nan),
-                    force_n=np.where(tr.present, f_r, np.nan),
-                )
-            )
-        out.append(drawn)
     return out
 
 

@@ -146,7 +146,7 @@ def diagnose(
             )
         run.say("judging what remains")
         with run.timed("remainder"):
-            remainder = _what_remains(run, after_out, final_fit.values, judged.x_base, accepted)
+            remainder = _what_remains(run, after_out, final_fit, judged.x_base, accepted)
     return Diagnosis(
         effects=accepted,
         ranking=judged.ranking,
@@ -388,11 +388,14 @@ def _states(traces: Sequence[Trace], outputs: Sequence[Outputs]) -> list[SimStat
 def _what_remains(
     run: _Run,
     after: Sequence[Outputs],
-    values: dict[str, float],
+    final: FitResult,
     x_base: float,
     accepted: Sequence[AcceptedEffect],
 ) -> Remainder:
     """Stage 7: the remainder after the named effects, and what it is like."""
     where = where_the_gap_lies(run.traces, _states(run.traces, after))
-    return remainder_of(run.traces, after, run.nominal, values, x_base, where,
-                        balances=not accepted)  # fmt: skip
+    remainder, sims = remainder_of(run.traces, after, run.nominal, final.values, x_base,
+                                   where, balances=not accepted,
+                                   candidate=final.candidate)  # fmt: skip
+    run.simulations += sims
+    return remainder

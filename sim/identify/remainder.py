@@ -9,7 +9,9 @@ training cycles' remainder and predicts the held-out cycles'; the kinds are judg
 one family against the model by the effects' own test (``decide.judge``): random sign
 flips of whole held-out blocks, maxT over the kinds. A remainder stands if some kind's
 gain passes at ``REMAINDER_ALPHA``: a model that is right is called inadequate at most
-that often, by construction, whatever the noise.
+that often, by construction, whatever the noise. It stands too where the held-out error
+is beyond anything the fitted model leaves on recordings of its own (``adequacy``): a
+misfit too irregular for any signature, on recordings too few to say what it is.
 
 The verdict joins that with the named effects (``VERDICTS``):
 
@@ -26,6 +28,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from sim.identify.adequacy import OwnExcess, own_excess
 from sim.identify.balance import fit_balances
 from sim.identify.decide import (
     ALPHA,
@@ -34,6 +37,7 @@ from sim.identify.decide import (
     family_p_values,
     p_value_of_gains,
 )
+from sim.identify.fitting import Candidate
 from sim.identify.heldout import Outputs, heldout_excess
 from sim.identify.signature import Signature, SignatureFit, fit_signatures
 from sim.identify.traces import Trace
@@ -51,8 +55,8 @@ REMAINDER_ALPHA = ALPHA / 2
 VERDICT_WORDS = {
     "baseline_adequate": "baseline adequate: no systematic gap beyond the noise",
     "explained": "explained: the named effects close the gap to the noise",
-    "partly_explained": "partly explained: the named effects leave a systematic remainder",
-    "unexplained": "unexplained: a systematic gap that no candidate effect closes",
+    "partly_explained": "partly explained: the named effects leave a remainder beyond the noise",
+    "unexplained": "unexplained: a gap beyond the noise that no candidate effect closes",
 }
 
 
@@ -73,9 +77,31 @@ class Remainder:
     signature: list[Signature] = field(default_factory=list)
     #: The fits behind ``signature`` (for plots), by ``SignatureFit.name``.
     fits: dict[str, SignatureFit] = field(default_factory=dict, repr=False)
+    #: The held-out excess against the fitted model's own replicates (None: not tested).
+    own: OwnExcess | None = None
+
+    @property
+    def gross(self) -> bool:
+        """Beyond what the fitted model leaves on its own recordings."""
+        return self.own is not None and self.own.gross
+
+    @property
+    def state(self) -> str:
+        """What remains, in words (the CLI's and the report's)."""
+        if not self.beyond_noise:
+            return "within what the noise allows"
+        if any(s.passes for s in self.signature):
+            return "beyond the noise"
+        assert self.own is not None
+        return (
+            f"beyond the noise: the held-out error is {self.own.observed:.3g} × the noise, "
+            f"where the fitted model leaves at most {self.own.bound:.3g} × on recordings of "
+            "its own, but no signature term repeats from cycle to cycle — the recordings are "
+            "too few, or the misfit too irregular, to say what it is"
+        )
 
     def to_dict(self) -> dict[str, object]:
-        """JSON keys beyond_noise, p_value, excess, share_of_gap, where, signature."""
+        """JSON keys beyond_noise, p_value, excess, share_of_gap, where, signature, own."""
         return {
             "beyond_noise": self.beyond_noise,
             "p_value": self.p_value,
@@ -84,6 +110,7 @@ class Remainder:
             "where": self.where.to_dict() if self.where is not None else None,
             "signature": [s.to_dict() for s in self.signature if s.passes],
             "kinds_tried": [s.to_dict() for s in self.signature],
+            "own_excess": self.own.to_dict() if self.own is not None else None,
         }
 
 
@@ -190,25 +217,35 @@ def remainder_of(
     x_base: float,
     where: Where | None = None,
     balances: bool = False,
-) -> Remainder:
+    candidate: Candidate | None = None,
+) -> tuple[Remainder, int]:
     """The final model's remainder: judged, described, and its share of the baseline's gap.
 
     ``balances``: judge the force balances' variants too (where no effect is named).
+    ``candidate``: the final model, whose own replicates the held-out error is held
+    against (``adequacy``); None: not. Returns the remainder and the simulations spent.
     """
     signatures, fits, _ = judge_signatures(traces, outputs, nominal, values, balances)
     excess = heldout_excess(traces, outputs)
+    own, sims = (
+        own_excess(candidate, values, traces, nominal, excess)
+        if candidate is not None
+        else (None, 0)
+    )
     passing = [s for s in signatures if s.passes]
     p_value = min((s.p_family for s in signatures), default=1.0)
     share = (excess - 1.0) / (x_base - 1.0) if x_base > 1.0 else 0.0
-    return Remainder(
-        beyond_noise=bool(passing),
+    remainder = Remainder(
+        beyond_noise=bool(passing) or (own is not None and own.gross),
         p_value=p_value,
         excess=excess,
         share_of_gap=min(max(share, 0.0), 1.0),
         where=where,
         signature=signatures,
         fits=fits,
+        own=own,
     )
+    return remainder, sims
 
 
 def verdict(named: bool, remainder: Remainder) -> str:

@@ -20,6 +20,7 @@ from sim.identify.fitting import Candidate
 from sim.identify.heldout import Outputs, channel_gap
 from sim.identify.intervals import (
     ParameterIntervals,
+    combined_error,
     gap_intervals,
     parameter_intervals,
     sandwich_covariance,
@@ -245,3 +246,29 @@ def test_a_parameter_the_recordings_do_not_feel_has_no_interval(stand: StandConf
         assert name in sure.reaches_bound
     lo, hi = sure.intervals["stiffness_scale"]
     assert lo <= truth["stiffness_scale"] <= hi
+
+
+def test_a_spread_from_few_replicates_carries_their_degrees_of_freedom() -> None:
+    # A bootstrap spread from six replicates that dominates the sandwich: five degrees of
+    # freedom (and a bit more for the bias term's own share), so its t is about 2.5, not
+    # the blocks' 1.97; a dominant sandwich keeps the blocks' many degrees of freedom.
+    se, dof = combined_error(0.1, 200.0, 1.0, 6)
+    assert se == pytest.approx(math.sqrt(1.0 + 1.0 / 6))
+    assert 5.0 <= dof < 7.0
+    se, dof = combined_error(1.0, 200.0, 0.01, 6)
+    assert se == pytest.approx(1.0, rel=1e-4)
+    assert dof > 150.0
+    # Coverage: the estimate off by a normal error of unit spread, the spread estimated
+    # from six draws of it: a t on the combined degrees of freedom covers at 95 %, the
+    # normal quantile does not.
+    rng = np.random.default_rng(3)
+    hits_t = hits_z = 0
+    trials = 4000
+    for _ in range(trials):
+        shift = rng.normal(0.0, 1.0, 6)
+        miss = rng.normal(0.0, 1.0)
+        se, dof = combined_error(0.01, 200.0, float(np.std(shift, ddof=1)), 6)
+        hits_t += abs(miss) <= stats.t.ppf(0.975, dof) * se
+        hits_z += abs(miss) <= 1.96 * se
+    assert hits_t / trials >= 0.94
+    assert hits_z / trials < hits_t / trials - 0.02

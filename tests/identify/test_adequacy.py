@@ -1,0 +1,80 @@
+"""A gross misfit: a held-out error beyond what the fitted model leaves on its own recordings."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from sim.checks.check import SMALL_CAMPAIGN, make_campaign
+from sim.config import StandConfig
+from sim.identify.adequacy import GROSS_ALPHA, own_excess, prediction_bound
+from sim.identify.fitting import Candidate
+from sim.identify.heldout import heldout_excess
+from sim.identify.remainder import remainder_of, verdict
+from sim.identify.screening import outputs_of
+from sim.identify.traces import Trace
+
+HEAVY = 8.131
+
+
+def test_one_more_draw_exceeds_the_prediction_bound_about_as_often_as_its_alpha() -> None:
+    # Log-normal excesses (what replicates of a right model give): the bound from eight
+    # of them is passed by a ninth at GROSS_ALPHA; a known noise unit only narrows it.
+    rng = np.random.default_rng(0)
+    trials = 20000
+    draws = np.exp(rng.normal(0.3, 0.1, (trials, 9)))
+    passed = sum(row[8] > prediction_bound(row[:8], 0.0) for row in draws)
+    assert 0.3 * GROSS_ALPHA * trials <= passed <= 2.5 * GROSS_ALPHA * trials
+    wider = sum(row[8] > prediction_bound(row[:8], 0.05) for row in draws[:2000])
+    assert wider <= sum(row[8] > prediction_bound(row[:8], 0.0) for row in draws[:2000])
+    assert prediction_bound([1.2, 1.3, 1.25], 0.0) > 1.3
+
+
+@pytest.fixture(scope="module")
+def campaign(stand: StandConfig) -> tuple[list[Trace], dict[str, float]]:
+    traces, _, truth = make_campaign(stand, "none", HEAVY, np.random.default_rng(4), SMALL_CAMPAIGN)
+    scales = {k: truth[k] for k in ("stiffness_scale", "damping_scale", "friction_scale")}
+    return traces, scales
+
+
+def test_the_true_model_lies_within_its_own_replicates_and_a_wrong_one_does_not(
+    stand: StandConfig, campaign: tuple[list[Trace], dict[str, float]]
+) -> None:
+    traces, truth = campaign
+    nominal = stand.stand_params("final", HEAVY)
+    base = Candidate.build()
+    right = heldout_excess(traces, outputs_of(base, truth, traces, nominal))
+    own, sims = own_excess(base, truth, traces, nominal, right)
+    assert not own.gross
+    assert sims == len(traces) * (1 + len(own.replicates))
+    # The replicates leave what the recordings leave: the same noise, the same restarts.
+    assert own.bound > right > 0.8 * min(own.replicates)
+    wrong_values = {**truth, "stiffness_scale": 0.7 * truth["stiffness_scale"]}
+    wrong = heldout_excess(traces, outputs_of(base, wrong_values, traces, nominal))
+    own_wrong, _ = own_excess(base, wrong_values, traces, nominal, wrong)
+    assert own_wrong.gross
+    assert own_wrong.to_dict()["gross"] is True
+
+
+def test_a_gross_misfit_that_no_signature_repeats_is_not_called_adequate(
+    stand: StandConfig, campaign: tuple[list[Trace], dict[str, float]]
+) -> None:
+    # A misfit irregular from cycle to cycle: every held-out cycle's force off by a
+    # different random offset, so no signature of the training cycles predicts it.
+    traces, truth = campaign
+    nominal = stand.stand_params("final", HEAVY)
+    base = Candidate.build()
+    rng = np.random.default_rng(7)
+    outputs = outputs_of(base, truth, traces, nominal)
+    for tr, out in zip(traces, outputs, strict=True):
+        for c in np.unique(tr.cycle):
+            at = tr.cycle == c
+            out.force_n[at] += rng.normal(0.0, 40.0 * tr.noise_force_n)
+    excess = heldout_excess(traces, outputs)
+    remainder, _ = remainder_of(traces, outputs, nominal, truth, excess, candidate=base)
+    assert remainder.gross and remainder.beyond_noise
+    assert verdict(False, remainder) == "unexplained"
+    assert "too few, or the misfit too irregular" in remainder.state
+    alone, _ = remainder_of(traces, outputs, nominal, truth, excess)
+    if not any(s.passes for s in alone.signature):
+        assert verdict(False, alone) == "baseline_adequate"  # what the guard is for
