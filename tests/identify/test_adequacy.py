@@ -11,6 +11,7 @@ from sim.identify.adequacy import GROSS_ALPHA, own_excess, prediction_bound
 from sim.identify.fitting import Candidate
 from sim.identify.heldout import heldout_excess
 from sim.identify.remainder import remainder_of, verdict
+from sim.identify.replicates import reading_step
 from sim.identify.screening import outputs_of
 from sim.identify.traces import Trace
 
@@ -78,3 +79,15 @@ def test_a_gross_misfit_that_no_signature_repeats_is_not_called_adequate(
     alone, _ = remainder_of(traces, outputs, nominal, truth, excess)
     if not any(s.passes for s in alone.signature):
         assert verdict(False, alone) == "baseline_adequate"  # what the guard is for
+
+
+def test_a_channel_read_in_counts_is_replicated_in_counts() -> None:
+    # A dial gauge read in 1 µm counts whose noise is a third of a count: at rest it reads
+    # one count throughout (no rest noise), in motion it is off by up to half a count.
+    rng = np.random.default_rng(2)
+    motion = 50e-6 * np.sin(np.linspace(0.0, 20.0, 8000))
+    read = np.round((motion + rng.normal(0.0, 0.3e-6, motion.size)) / 1e-6) * 1e-6
+    assert reading_step(read) == pytest.approx(1e-6, rel=1e-6)
+    assert reading_step(motion) == 0.0  # floating point: steps of every size
+    assert reading_step(read + rng.normal(0.0, 1e-9, read.size)) == 0.0
+    assert reading_step(np.full(100, 3e-6)) == 0.0  # never moves: no count to read
