@@ -18,7 +18,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from bench_diagnosis_trees import campaign  # noqa: E402
+from bench_diagnosis_trees import campaign
 
 CAMPAIGNS = (("none", 3.096), ("none", 8.131), ("fibre_viscoelastic", 8.131))
 
