@@ -5,6 +5,10 @@ not tell from it (``indistinguishable_from``); failing those, against the runner
 ranking and against the baseline alone; with nothing named, each of the ranking's
 ``MAX_UNNAMED`` best against the baseline. Each rival is the diagnosis' fitted baseline plus
 its effect at the parameters its own refit found (the ranking's ``params``).
+
+Second, the plan narrows the widest interval (``widest_interval``: the named effects'
+parameter whose 95 % interval is widest against its value): among motions that tell every
+pair apart, the one that tells most of it.
 """
 
 from __future__ import annotations
@@ -17,11 +21,14 @@ from typing import TYPE_CHECKING, Any
 from labstand.errors import CommandError, ExitCode
 
 if TYPE_CHECKING:
+    from collections.abc import Sequence
+
     from drivers.signals import SignalSpec
     from labstand.fitted import FittedStand
     from sim.config import StandConfig
     from sim.envelope import SlackRule
-    from sim.planner import Noise, Plan, Rival, Setting
+    from sim.identify.traces import Trace
+    from sim.planner import Narrowing, Noise, Plan, Rival, Setting
 
 __all__ = [
     "PLAN_OPTIONS",
@@ -30,6 +37,7 @@ __all__ = [
     "rivals_of",
     "setting_for",
     "signal_from_plan",
+    "widest_interval",
 ]
 
 BASELINE = "none"
@@ -78,6 +86,48 @@ def rivals_of(fitted: FittedStand) -> tuple[list[Rival], list[tuple[str, str]]]:
     return [models[n] for n in sorted(models)], pairs
 
 
+def widest_interval(fitted: FittedStand) -> tuple[str, float, tuple[float, float]] | None:
+    """The named effects' parameter whose interval is widest against its value, or None.
+
+    ``("effect.param", value, (low, high))``, from the diagnosis' ``effects[].intervals``;
+    parameters held at a level (an interval of no width) are not candidates.
+    """
+    best: tuple[float, tuple[str, float, tuple[float, float]]] | None = None
+    for item in fitted.raw.get("effects") or []:
+        if not isinstance(item, dict):
+            continue
+        params, intervals = item.get("params") or {}, item.get("intervals") or {}
+        for name, pair in intervals.items():
+            value = params.get(name)
+            if not isinstance(value, (int, float)) or not isinstance(pair, list) or len(pair) != 2:
+                continue
+            low, high = float(min(pair)), float(max(pair))
+            width = (high - low) / max(abs(float(value)), 1e-12)
+            if high > low and (best is None or width > best[0]):
+                best = (width, (f"{item.get('effect')}.{name}", float(value), (low, high)))
+    return best[1] if best is not None else None
+
+
+def narrowing_for(
+    fitted: FittedStand, config: StandConfig, noise: Noise, traces: Sequence[Trace] = ()
+) -> Narrowing | None:
+    """The interval the plan narrows second, with what the recordings hold about it."""
+    from sim.discrimination import parameter_information
+    from sim.planner import Narrowing
+    from sim.prediction import corner_variants
+
+    widest = widest_interval(fitted)
+    if widest is None or not fitted.effects:
+        return None
+    key, value, interval = widest
+    held = 0.0
+    for tr in traces:
+        stand = config.stand_params("final", tr.mass_kg)
+        stand = stand.with_(**corner_variants(stand, fitted.spread())[0])
+        held += parameter_information(tr, stand, fitted.effects, key, noise.u_m, noise.force_n)
+    return Narrowing(fitted.effects[0].name, key, value, interval, held if traces else None)
+
+
 @dataclass(frozen=True)
 class PlanAnswer:
     """The plan with what it was searched against, for the line and the JSON."""
@@ -88,6 +138,7 @@ class PlanAnswer:
     rule: SlackRule
     noise: Noise
     budget_s: float
+    narrowing: Narrowing | None = None
 
     @property
     def decisive(self) -> bool:
@@ -114,13 +165,38 @@ class PlanAnswer:
             f"{sep:.1f} noise units{weak}"
         )
         return (
-            f"{plan.best.describe()} {what}; "
+            f"{plan.best.describe()} {what}{self._narrows_words()}; "
             f"predicted slack {worst.slack_share:.0%}, peak {worst.peak_tension_n:.0f} N, "
             f"weight travel {worst.weight_travel_m * 1e3:.0f} mm"
         )
 
+    def _narrows_words(self) -> str:
+        narrow = self.narrowing
+        predicted = narrow.predicted(self.plan.information) if narrow is not None else None
+        if narrow is None or predicted is None:
+            return ""
+        low, high = narrow.interval
+        return (
+            f", and narrows {narrow.key} from [{low:.4g}, {high:.4g}] to "
+            f"[{predicted[0]:.4g}, {predicted[1]:.4g}] (predicted)"
+        )
+
+    def _narrows_dict(self) -> dict[str, Any] | None:
+        narrow = self.narrowing
+        if narrow is None:
+            return None
+        predicted = narrow.predicted(self.plan.information)
+        return {
+            "parameter": narrow.key,
+            "value": narrow.value,
+            "interval": list(narrow.interval),
+            "information": self.plan.information,
+            "held_by_recordings": narrow.held,
+            "predicted_interval": list(predicted) if predicted is not None else None,
+        }
+
     def to_dict(self) -> dict[str, Any]:
-        """JSON: signal (as ``run`` takes it), separates, expected_separation, predicted."""
+        """JSON: the signal (as ``run`` takes it), separates, narrows, and predicted."""
         plan = self.plan
         out: dict[str, Any] = {
             "why": self.line(),
@@ -129,6 +205,7 @@ class PlanAnswer:
                 {"rivals": [a, b], "separation": sep} for (a, b), sep in plan.separations.items()
             ],
             "expected_separation": plan.expected_separation,
+            "narrows": self._narrows_dict(),
             "decisive": self.decisive,
             "predicted": None,
             "noise": {"u_m": self.noise.u_m, "force_n": self.noise.force_n},
@@ -156,11 +233,19 @@ class PlanAnswer:
         return out
 
 
-def setting_for(fitted: FittedStand, config: StandConfig, noise: Noise, rule: SlackRule) -> Setting:
+def setting_for(
+    fitted: FittedStand,
+    config: StandConfig,
+    noise: Noise,
+    rule: SlackRule,
+    narrowing: Narrowing | None = None,
+) -> Setting:
     """What the search needs of a diagnosis and a stand (its rivals, model, limits)."""
     from sim.planner import Setting
 
     rivals, pairs = rivals_of(fitted)
+    if narrowing is not None and narrowing.rival not in {r.name for r in rivals}:
+        narrowing = None
     return Setting(
         nominal=config.stand_params("final"),
         spread=fitted.spread(),
@@ -172,6 +257,7 @@ def setting_for(fitted: FittedStand, config: StandConfig, noise: Noise, rule: Sl
         rule=rule,
         limits=config.drive,
         rate_hz=config.sample_rate_hz,
+        narrow=narrowing,
     )
 
 
@@ -182,13 +268,19 @@ def plan_motion_for(
     noise: Noise,
     rule: SlackRule,
     budget_s: float,
+    traces: Sequence[Trace] = (),
 ) -> PlanAnswer:
-    """Search the stand's motions for the one that best separates the diagnosis' rivals."""
+    """Search the stand's motions for the one that best separates the diagnosis' rivals.
+
+    ``traces``: the recordings behind the diagnosis, for how far the plan narrows the
+    widest interval (without them it is still narrowed, but by how much is not said).
+    """
     from sim.planner import motion_grid, search
 
-    setting = setting_for(fitted, config, noise, rule)
+    narrowing = narrowing_for(fitted, config, noise, traces)
+    setting = setting_for(fitted, config, noise, rule, narrowing)
     plan = search(setting, motion_grid(config.drive, masses_kg), budget_s)
-    return PlanAnswer(plan, fitted, config, rule, noise, budget_s)
+    return PlanAnswer(plan, fitted, config, rule, noise, budget_s, setting.narrow)
 
 
 #: The signal options ``run --plan`` takes from the plan (the command line may not add).

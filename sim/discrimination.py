@@ -38,6 +38,7 @@ __all__ = [
     "Miss",
     "baseline_steps",
     "effect_steps",
+    "parameter_information",
     "recording_of",
     "residual_separation",
     "shooting_separation",
@@ -198,3 +199,52 @@ def shooting_separation(
         channel_floor.append(float(np.sqrt(np.mean(off**2))))
     beyond = float(np.sqrt(2.0 * np.mean(miss**2)))
     return Miss(beyond, (channel_miss[0], channel_miss[1]), (channel_floor[0], channel_floor[1]))
+
+
+def parameter_information(
+    recording: Trace,
+    stand: StandParams,
+    effects: Sequence[EffectSpec],
+    key: str,
+    noise_u_m: float,
+    noise_force_n: float,
+) -> float:
+    """What a recording tells of one effect parameter, beyond what a refit absorbs.
+
+    The model runs from the recording's measured states on its segments (as
+    ``shooting_separation``) at its values and one step off each parameter a re-diagnosis
+    refits; the outputs' slope along ``key`` (``"effect.param"``), less what the other
+    directions span (least squares), is summed in squares over the recording's samples
+    in units of each channel's floor (the noise plus the restarts' own miss): Fisher's
+    information about the parameter, per unit of it squared, as if the samples were
+    independent. They are not, so the figure ranks motions and compares recordings of one
+    stand (the share a test adds to what the recordings hold), not an interval by itself.
+    """
+    steps = effect_steps(effects)
+    own = next((s for s in steps if key in s), None)
+    if own is None:
+        raise ValueError(f"{key} is not a fitted parameter of {[e.name for e in effects]}")
+    effect, name = key.split(".", 1)
+    value = next(spec for spec in effects if spec.name == effect).resolved()[name]
+    seg = recording.segments
+    rate = recording.rate_hz
+    restarts = seg.restarts_ahead(_lead_samples(effects, rate))
+    others = [s for s in steps if key not in s]
+    u, f = Model(stand, effects).run_segments(
+        recording.x_m, rate, restarts, [{}, own, *baseline_steps(stand), *others]
+    )
+    z = np.concatenate([seg.assemble(u) / noise_u_m, seg.assemble(f) / noise_force_n], 1)
+    slope = (z[1] - z[0]) / (own[key] - value)
+    directions = np.asarray((z[2:] - z[0]).T, dtype=np.float64)
+    if directions.size:
+        slope = slope - directions @ np.linalg.lstsq(directions, slope, rcond=None)[0]
+    data = np.concatenate([recording.u_m / noise_u_m, recording.force_n / noise_force_n])
+    n = recording.samples
+    used = recording.present
+    information = 0.0
+    for c in range(2):
+        part = slice(c * n, (c + 1) * n)
+        ok = used & np.isfinite(data[part]) & np.isfinite(slope[part])
+        floor = float(np.sqrt(np.mean((data[part][ok] - z[0][part][ok]) ** 2)))
+        information += float(np.sum(slope[part][ok] ** 2)) / max(floor, 1.0) ** 2
+    return information

@@ -8,8 +8,11 @@ whether it may run; on those that may, each rival runs open loop from rest and s
 for a recording. The *separation* of two rivals is how far one misses the other's
 recording on the diagnosis' own multiple-shooting segments, after what a re-diagnosis
 would refit (``sim.discrimination``), in units of the gauges' noise, the lesser way
-round. The plan is the admissible motion with the largest separation of its
-worst-separated pair.
+round. The plan is the admissible motion that tells most pairs apart (by ``DECISIVE``
+noise units); among those that tell every pair apart, the one that narrows the widest
+interval most (``Narrowing``: the most information about that parameter beyond what a
+refit absorbs, ``sim.discrimination.parameter_information``); else the one with the
+largest separation of its worst-separated pair.
 
 Motions run in batches padded to one length (rest at the end), so the prediction's
 corners and each rival are one batch per chunk of motions, on all cores; the segment
@@ -26,7 +29,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from drivers.limits import DriveLimits
-from sim.discrimination import recording_of, shooting_separation
+from sim.discrimination import parameter_information, recording_of, shooting_separation
 from sim.effects.registry import EffectSpec
 from sim.envelope import (
     MotionFigures,
@@ -37,6 +40,7 @@ from sim.envelope import (
     figures_of,
     worst_of,
 )
+from sim.identify.traces import Trace
 from sim.model import BatchResult, Model
 from sim.motions import Candidate, lengthened, motion_grid, padded
 from sim.params import StandParams
@@ -46,6 +50,7 @@ __all__ = [
     "DECISIVE",
     "PLAN_MARGIN",
     "Candidate",
+    "Narrowing",
     "Noise",
     "Plan",
     "Rival",
@@ -90,6 +95,33 @@ class Noise:
 
 
 @dataclass(frozen=True)
+class Narrowing:
+    """The interval a plan narrows second: a named effect's parameter and its 95 % interval.
+
+    ``rival``: the rival whose model holds the parameter (the named effects'); ``held``:
+    the information the recordings already hold about it (``parameter_information``
+    summed over them), None where they are not at hand.
+    """
+
+    rival: str
+    key: str
+    value: float
+    interval: tuple[float, float]
+    held: float | None = None
+
+    def predicted(self, information: float) -> tuple[float, float] | None:
+        """The interval after a test that adds ``information``, if the recordings' is known.
+
+        Information adds, so the interval's width shrinks by √(held / (held + added)).
+        """
+        if self.held is None or self.held <= 0.0:
+            return None
+        shrink = float(np.sqrt(self.held / (self.held + information)))
+        low, high = self.interval
+        return self.value - (self.value - low) * shrink, self.value + (high - self.value) * shrink
+
+
+@dataclass(frozen=True)
 class Plan:
     """The search's answer.
 
@@ -107,6 +139,8 @@ class Plan:
         The admissible motions themselves (a side-by-side check draws among them).
     complete
         False when the time budget ended the search early.
+    information
+        What the chosen motion tells of the narrowed parameter (``Setting.narrow``).
     """
 
     best: Candidate | None
@@ -116,6 +150,7 @@ class Plan:
     admissible: int
     complete: bool
     options: tuple[Candidate, ...] = ()
+    information: float = 0.0
 
     @property
     def expected_separation(self) -> float:
@@ -123,15 +158,20 @@ class Plan:
         return min(self.separations.values(), default=0.0)
 
 
-def score(separations: dict[tuple[str, str], float]) -> tuple[int, float]:
-    """How well a motion separates: the pairs it tells apart (``DECISIVE``), then the worst.
+def score(
+    separations: dict[tuple[str, str], float], information: float = 0.0
+) -> tuple[int, float, float]:
+    """How well a motion settles: the pairs it tells apart, then the interval, then the worst.
 
     With several open questions (nothing named, each candidate against the baseline) a
     test that settles most of them beats one that settles none a little better; with
-    one pair it is the separation itself.
+    one pair it is the separation itself. A motion that tells every pair apart has done
+    the first job; among those, the one with the most ``information`` about the widest
+    interval's parameter does the second.
     """
     told = sum(sep >= DECISIVE for sep in separations.values())
-    return told, min(separations.values(), default=0.0)
+    second = information if told == len(separations) else 0.0
+    return told, second, min(separations.values(), default=0.0)
 
 
 @dataclass(frozen=True)
@@ -151,6 +191,8 @@ class Setting:
         The explanations to separate; ``pairs`` names which against which.
     noise, envelope, rule, limits, rate_hz
         The separation's unit, the limits, the drive, the sample rate.
+    narrow
+        The interval to narrow second, if any.
     """
 
     nominal: StandParams  # at no particular mass
@@ -163,6 +205,7 @@ class Setting:
     rule: SlackRule
     limits: DriveLimits
     rate_hz: float
+    narrow: Narrowing | None = None
 
 
 def _predictions(
@@ -209,17 +252,34 @@ def _rival_figures(
     ]
 
 
-def _separations(
+def _recordings(
     setting: Setting, stand: StandParams, runs: dict[str, BatchResult], j: int, x: FloatArray
-) -> dict[tuple[str, str], float]:
-    """Each pair's separation on motion j, on the diagnosis' segments, the lesser way round."""
+) -> dict[str, Trace]:
+    """Each rival's run on motion j as the diagnosis would see its recording."""
     n = x.size
     noise = setting.noise
-    recordings = {
+    return {
         name: recording_of(name, x, r.u_m[j, :n], r.force_n[j, :n], setting.rate_hz,
                            stand.mass_kg, (noise.u_m, noise.force_n))
         for name, r in runs.items()
     }  # fmt: skip
+
+
+def _information(setting: Setting, stand: StandParams, recordings: dict[str, Trace]) -> float:
+    """What the narrowed rival's recording of a motion tells of its parameter (0: no narrowing)."""
+    narrow = setting.narrow
+    if narrow is None or narrow.rival not in recordings:
+        return 0.0
+    effects = next(r.effects for r in setting.rivals if r.name == narrow.rival)
+    return parameter_information(recordings[narrow.rival], stand, effects, narrow.key,
+                                 setting.noise.u_m, setting.noise.force_n)  # fmt: skip
+
+
+def _separations(
+    setting: Setting, stand: StandParams, recordings: dict[str, Trace]
+) -> dict[tuple[str, str], float]:
+    """Each pair's separation on a motion, on the diagnosis' segments, the lesser way round."""
+    noise = setting.noise
     models = {rival.name: rival.effects for rival in setting.rivals}
     misses: dict[tuple[str, str], float] = {}
 
@@ -244,8 +304,11 @@ def _separations(
     }  # fmt: skip
 
 
-#: A judged motion: its score, itself, each pair's separation, its safety prediction.
-_Judged = tuple[tuple[int, float], Candidate, dict[tuple[str, str], float], Prediction]
+#: A judged motion: its score, itself, each pair's separation, its safety prediction, and
+#: what it tells of the narrowed parameter.
+_Judged = tuple[
+    tuple[int, float, float], Candidate, dict[tuple[str, str], float], Prediction, float
+]
 
 
 def search(
@@ -272,7 +335,8 @@ def search(
     if best is None:
         return Plan(None, {}, None, searched, 0, complete)
     best = _as_planned(setting, best)
-    return Plan(best[1], best[2], best[3], searched, len(options), complete, tuple(options))
+    return Plan(best[1], best[2], best[3], searched, len(options), complete, tuple(options),
+                best[4])  # fmt: skip
 
 
 def _as_planned(setting: Setting, found: _Judged) -> _Judged:
@@ -310,8 +374,10 @@ def _judge(setting: Setting, mass: float, group: Sequence[Candidate]) -> list[_J
         pred = Prediction(pred.nominal, worst_of([pred.worst, *rivals]), pred.runs + len(rivals))
         if not _admissible(pred, setting):
             continue
-        seps = _separations(setting, fitted, runs, j, x[i, :n])
-        found.append((score(seps), group[i], seps, pred))
+        recordings = _recordings(setting, fitted, runs, j, x[i, :n])
+        seps = _separations(setting, fitted, recordings)
+        information = _information(setting, fitted, recordings)
+        found.append((score(seps, information), group[i], seps, pred, information))
     return found
 
 

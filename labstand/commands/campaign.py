@@ -154,7 +154,9 @@ def run(args: argparse.Namespace) -> int:
         if step == rounds:
             _say(f"not certain after {rounds} planned test(s): stopped (--until {args.until})")
             return ExitCode.OK
-        answer = plan_motion_for(fitted, config, masses, noise_of(traces), rule, args.budget_s)
+        answer = plan_motion_for(
+            fitted, config, masses, noise_of(traces), rule, args.budget_s, traces
+        )
         _say(f"plan {step + 1}: {answer.line()}")
         if answer.plan.best is None or not answer.decisive:
             _say("no motion the stand allows settles it: stopped, the answer stays open")

@@ -142,7 +142,7 @@ def run(args: argparse.Namespace) -> int:
     limits = SafetyLimits()
     rule = SlackRule(limits.slack_force_n, limits.slack_max_s)
     started = time.perf_counter()
-    answer = plan_motion_for(fitted, config, masses, noise_of(traces), rule, args.budget_s)
+    answer = plan_motion_for(fitted, config, masses, noise_of(traces), rule, args.budget_s, traces)
     out = answer.to_dict()
     out["search_s"] = time.perf_counter() - started
     if args.output is not None:  # under a temporary name, renamed when whole

@@ -163,7 +163,7 @@ def test_motions_with_brief_slack_are_plannable_within_the_margins() -> None:
 
 
 def test_the_score_counts_pairs_told_apart_before_the_worst() -> None:
-    assert score({("a", "none"): 3.0, ("b", "none"): 0.2}) == (1, 0.2)
+    assert score({("a", "none"): 3.0, ("b", "none"): 0.2}) == (1, 0.0, 0.2)
     many = {("a", "none"): 1.5, ("b", "none"): 1.1, ("c", "none"): 0.1}
     few = {("a", "none"): 9.0, ("b", "none"): 0.5, ("c", "none"): 0.4}
     assert score(many) > score(few)  # two questions settled beat one settled by more
