@@ -14,8 +14,10 @@ from sim.identify.remainder import remainder_of, verdict
 from sim.identify.replicates import reading_step
 from sim.identify.screening import outputs_of
 from sim.identify.traces import Trace
+from sim.params import StandParams
 
 HEAVY = 8.131
+Campaign = tuple[list[Trace], dict[str, float], StandParams]
 
 
 def test_one_more_draw_exceeds_the_prediction_bound_about_as_often_as_its_alpha() -> None:
@@ -32,17 +34,17 @@ def test_one_more_draw_exceeds_the_prediction_bound_about_as_often_as_its_alpha(
 
 
 @pytest.fixture(scope="module")
-def campaign(stand: StandConfig) -> tuple[list[Trace], dict[str, float]]:
+def campaign(stand: StandConfig) -> Campaign:
+    """A clean heavy campaign, its true baseline scales and the nominal stand."""
     traces, _, truth = make_campaign(stand, "none", HEAVY, np.random.default_rng(4), SMALL_CAMPAIGN)
     scales = {k: truth[k] for k in ("stiffness_scale", "damping_scale", "friction_scale")}
-    return traces, scales
+    return traces, scales, stand.stand_params("final", HEAVY)
 
 
 def test_the_true_model_lies_within_its_own_replicates_and_a_wrong_one_does_not(
-    stand: StandConfig, campaign: tuple[list[Trace], dict[str, float]]
+    campaign: Campaign,
 ) -> None:
-    traces, truth = campaign
-    nominal = stand.stand_params("final", HEAVY)
+    traces, truth, nominal = campaign
     base = Candidate.build()
     right = heldout_excess(traces, outputs_of(base, truth, traces, nominal))
     own, sims = own_excess(base, truth, traces, nominal, right)
@@ -58,14 +60,13 @@ def test_the_true_model_lies_within_its_own_replicates_and_a_wrong_one_does_not(
 
 
 def test_a_gross_misfit_that_no_signature_repeats_is_not_called_adequate(
-    stand: StandConfig, campaign: tuple[list[Trace], dict[str, float]]
+    campaign: Campaign,
 ) -> None:
     # A misfit irregular from cycle to cycle: every held-out cycle's force off by a
     # different random offset, so no signature of the training cycles predicts it.
-    traces, truth = campaign
-    nominal = stand.stand_params("final", HEAVY)
-    base = Candidate.build()
+    traces, truth, nominal = campaign
     rng = np.random.default_rng(7)
+    base = Candidate.build()
     outputs = outputs_of(base, truth, traces, nominal)
     for tr, out in zip(traces, outputs, strict=True):
         for c in np.unique(tr.cycle):
