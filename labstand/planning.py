@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING, Any
 from labstand.errors import CommandError, ExitCode
 
 if TYPE_CHECKING:
-    from collections.abc import Sequence
+    from collections.abc import Callable, Sequence
 
     from drivers.signals import SignalSpec
     from labstand.fitted import FittedStand
@@ -33,6 +33,7 @@ if TYPE_CHECKING:
 __all__ = [
     "PLAN_OPTIONS",
     "PlanAnswer",
+    "narrowing_for",
     "plan_motion_for",
     "rivals_of",
     "setting_for",
@@ -86,11 +87,14 @@ def rivals_of(fitted: FittedStand) -> tuple[list[Rival], list[tuple[str, str]]]:
     return [models[n] for n in sorted(models)], pairs
 
 
-def widest_interval(fitted: FittedStand) -> tuple[str, float, tuple[float, float]] | None:
+def widest_interval(
+    fitted: FittedStand, fitted_param: Callable[[str], bool] = lambda _key: True
+) -> tuple[str, float, tuple[float, float]] | None:
     """The named effects' parameter whose interval is widest against its value, or None.
 
-    ``("effect.param", value, (low, high))``, from the diagnosis' ``effects[].intervals``;
-    parameters held at a level (an interval of no width) are not candidates.
+    ``("effect.param", value, (low, high))``, from the diagnosis' ``effects[].intervals``,
+    among the keys ``fitted_param`` accepts; parameters held at a level (an interval of
+    no width) are not candidates.
     """
     best: tuple[float, tuple[str, float, tuple[float, float]]] | None = None
     for item in fitted.raw.get("effects") or []:
@@ -99,12 +103,15 @@ def widest_interval(fitted: FittedStand) -> tuple[str, float, tuple[float, float
         params, intervals = item.get("params") or {}, item.get("intervals") or {}
         for name, pair in intervals.items():
             value = params.get(name)
+            key = f"{item.get('effect')}.{name}"
             if not isinstance(value, (int, float)) or not isinstance(pair, list) or len(pair) != 2:
+                continue
+            if not fitted_param(key):
                 continue
             low, high = float(min(pair)), float(max(pair))
             width = (high - low) / max(abs(float(value)), 1e-12)
             if high > low and (best is None or width > best[0]):
-                best = (width, (f"{item.get('effect')}.{name}", float(value), (low, high)))
+                best = (width, (key, float(value), (low, high)))
     return best[1] if best is not None else None
 
 
@@ -112,11 +119,12 @@ def narrowing_for(
     fitted: FittedStand, config: StandConfig, noise: Noise, traces: Sequence[Trace] = ()
 ) -> Narrowing | None:
     """The interval the plan narrows second, with what the recordings hold about it."""
-    from sim.discrimination import parameter_information
+    from sim.discrimination import effect_steps, parameter_information
     from sim.planner import Narrowing
     from sim.prediction import corner_variants
 
-    widest = widest_interval(fitted)
+    refitted = {key for step in effect_steps(fitted.effects) for key in step}
+    widest = widest_interval(fitted, refitted.__contains__)
     if widest is None or not fitted.effects:
         return None
     key, value, interval = widest

@@ -101,7 +101,7 @@ class Remainder:
         )
 
     def to_dict(self) -> dict[str, object]:
-        """JSON keys beyond_noise, p_value, excess, share_of_gap, where, signature, own."""
+        """JSON keys beyond_noise, p_value, excess, share_of_gap, where, signature, own_excess."""
         return {
             "beyond_noise": self.beyond_noise,
             "p_value": self.p_value,

@@ -105,3 +105,21 @@ def test_the_recordings_information_is_what_the_prediction_counts_from() -> None
     assert high - low == pytest.approx((0.034 - 0.027) / np.sqrt(2.0), rel=1e-9)
     assert narrowing_for(fitted, config, NOISE) is not None
     assert narrowing_for(fitted, config, NOISE).held is None  # type: ignore[union-attr]
+
+
+def test_only_a_parameter_a_refit_moves_is_narrowed() -> None:
+    # A diagnosis file whose widest interval is on a parameter no refit moves (the dial
+    # gauge's offset: the recordings count u from rest) is passed over for the next
+    # widest: the search could not measure what a test tells of it.
+    data = _diagnosis({})
+    data["effects"] = [
+        {
+            "effect": "dial_gauge_calibration",
+            "params": {"gain_error": 0.05, "offset_m": 1e-5},
+            "intervals": {"gain_error": [0.04, 0.06], "offset_m": [-1e-4, 1e-4]},
+        }
+    ]
+    fitted = fitted_from_dict(data, Path("d.json"))
+    assert widest_interval(fitted) == ("dial_gauge_calibration.offset_m", 1e-5, (-1e-4, 1e-4))
+    narrowing = narrowing_for(fitted, default_config(), NOISE)
+    assert narrowing is not None and narrowing.key == "dial_gauge_calibration.gain_error"
