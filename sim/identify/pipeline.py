@@ -395,7 +395,7 @@ def _what_remains(
     """Stage 7: the remainder after the named effects, and what it is like."""
     where = where_the_gap_lies(run.traces, _states(run.traces, after))
     remainder, sims = remainder_of(run.traces, after, run.nominal, final.values, x_base,
-                                   where, balances=not accepted,
-                                   candidate=final.candidate)  # fmt: skip
+                                   where, balances=not accepted, candidate=final.candidate,
+                                   named=bool(accepted))  # fmt: skip
     run.simulations += sims
     return remainder

@@ -77,6 +77,10 @@ def test_a_gross_misfit_that_no_signature_repeats_is_not_called_adequate(
     assert remainder.gross and remainder.beyond_noise
     assert verdict(False, remainder) == "unexplained"
     assert "too few, or the misfit too irregular" in remainder.state
+    # Where effects are named the comparison is reported, and the signatures decide.
+    beside, _ = remainder_of(traces, outputs, nominal, truth, excess, candidate=base, named=True)
+    assert beside.gross and beside.own is not None
+    assert beside.beyond_noise == any(s.passes for s in beside.signature)
     alone, _ = remainder_of(traces, outputs, nominal, truth, excess)
     if not any(s.passes for s in alone.signature):
         assert verdict(False, alone) == "baseline_adequate"  # what the guard is for

@@ -40,7 +40,10 @@ def test_ten_second_run_is_complete_and_replays(
     x, cmd = g["x_mm"], rec.command["x_cmd_mm"]
     assert abs(cmd.max() - 30.0) < 1e-9 and abs(x.max() - 30.0) < 0.1
     lag = min(range(-40, 41), key=lambda k: float(np.sum((np.roll(cmd, k) - x) ** 2)))
-    assert 0 <= lag <= 20, f"x lags the command by {lag / 2:g} ms"
+    # The command is the profile placed at the gauges' clock by the host's estimate of
+    # when the drive started (host → device time), good to a sample: on a loaded machine
+    # x has led it by one (0.5 ms), never more.
+    assert -1 <= lag <= 20, f"x lags the command by {lag / 2:g} ms"
     assert np.abs(np.roll(cmd, lag) - x)[100:-100].max() < 0.5  # mm
     # drive polls at tens of Hz with position and status; enabled while running
     d = rec.drive
