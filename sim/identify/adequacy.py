@@ -35,13 +35,16 @@ from sim.identify.replicates import replicate_traces
 from sim.identify.traces import Trace
 from sim.params import StandParams
 
-__all__ = ["GROSS_ALPHA", "OWN_REPLICATES", "OwnExcess", "own_excess"]
+__all__ = ["GROSS_ALPHA", "NOISELESS", "OWN_REPLICATES", "OwnExcess", "own_excess"]
 
 #: Recordings the fitted model makes of itself (each one simulation per recording).
 OWN_REPLICATES = 8
 #: How often a right model is called a gross misfit, at most (about: the bound assumes
 #: the replicates' log excess is normal).
 GROSS_ALPHA = 1e-3
+#: Replicates whose held-out excess falls below this carry no noise in some channel (a
+#: recording without noise, or read in steps too fine to see): no bound is drawn.
+NOISELESS = 1e-6
 
 
 @dataclass(frozen=True)
@@ -59,13 +62,13 @@ class OwnExcess:
         return self.observed > self.bound
 
     def to_dict(self) -> dict[str, object]:
-        """JSON: observed, the replicates' median and range, the bound, gross."""
+        """JSON: observed, the replicates' median and range, the bound (null: none), gross."""
         reps = np.asarray(self.replicates)
         return {
             "observed": self.observed,
             "replicates_median": float(np.median(reps)),
             "replicates_range": [float(reps.min()), float(reps.max())],
-            "bound": self.bound,
+            "bound": self.bound if math.isfinite(self.bound) else None,
             "alpha": GROSS_ALPHA,
             "gross": self.gross,
         }
@@ -75,7 +78,10 @@ def prediction_bound(excesses: Sequence[float], resolution: float) -> float:
     """One-sided upper ``GROSS_ALPHA`` bound of one more excess like these (log-normal).
 
     ``resolution``: the noise unit's relative standard error, added in quadrature.
+    Infinite (no bound) where a replicate fell below ``NOISELESS``.
     """
+    if not all(math.isfinite(x) and x >= NOISELESS for x in excesses):
+        return math.inf
     logs = np.log(np.asarray(excesses, float))
     n = logs.size
     spread = float(np.std(logs, ddof=1)) if n > 1 else 0.0

@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 
 from sim.checks.check import SMALL_CAMPAIGN, make_campaign
 from sim.config import StandConfig
-from sim.identify.adequacy import GROSS_ALPHA, own_excess, prediction_bound
+from sim.identify.adequacy import GROSS_ALPHA, OwnExcess, own_excess, prediction_bound
 from sim.identify.fitting import Candidate
 from sim.identify.heldout import heldout_excess
 from sim.identify.remainder import remainder_of, verdict
@@ -96,3 +98,14 @@ def test_a_channel_read_in_counts_is_replicated_in_counts() -> None:
     assert reading_step(motion) == 0.0  # floating point: steps of every size
     assert reading_step(read + rng.normal(0.0, 1e-9, read.size)) == 0.0
     assert reading_step(np.full(100, 3e-6)) == 0.0  # never moves: no count to read
+
+
+def test_replicates_without_noise_in_a_channel_give_no_bound() -> None:
+    # A channel with no noise at all in the replicates (a gauge read in steps too fine to
+    # see, at rest reading one value) gives them no error there, and their pooled excess
+    # collapses (1e-75): no bound is drawn from that, nothing is called gross, and the JSON
+    # stays JSON.
+    assert prediction_bound([1e-75] * 8, 0.05) == float("inf")
+    own = OwnExcess(50.0, (1e-75,) * 8, prediction_bound([1e-75] * 8, 0.05))
+    assert not own.gross
+    assert json.loads(json.dumps(own.to_dict()))["bound"] is None
