@@ -16,7 +16,9 @@ replicates' one-sided prediction bound at ``GROSS_ALPHA`` (Student t on the repl
 log excess), widened by how well the noise unit is known (the rest spread the excess
 counts in, ``balance.noise_resolution``), since the replicates use that unit as exact.
 A right model is called a gross misfit at most about ``GROSS_ALPHA`` of the time, beside
-the remainder test's own rate.
+the remainder test's own rate, where the replicates carry what the recordings do; with
+effects named they did not (a right branch on ``make demo`` left 1.5× its replicates), so
+there ``remainder`` reports the comparison without letting it decide.
 """
 
 from __future__ import annotations
