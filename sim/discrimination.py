@@ -78,10 +78,8 @@ def residual_separation(difference: FloatArray, directions: FloatArray) -> float
     ``directions`` (2n, m): what a refit would absorb, removed by least squares. The
     result is the RMS per channel pair: √2 × the RMS over the 2n stacked values.
     """
-    if directions.size:
-        coef, *_ = np.linalg.lstsq(directions, difference, rcond=None)
-        difference = difference - directions @ coef
-    return float(np.sqrt(2.0 * np.mean(np.square(difference))))
+    beyond = _beyond(difference, directions.T)
+    return float(np.sqrt(2.0 * np.mean(np.square(beyond))))
 
 
 #: The gauges' noise added to a rival's run before it stands in for a recording is drawn
@@ -157,6 +155,45 @@ class Miss:
         return float(np.sqrt(product - 1.0))
 
 
+def _segment_runs(
+    recording: Trace,
+    stand: StandParams,
+    effects: Sequence[EffectSpec],
+    variants: list[Variant],
+    noise_u_m: float,
+    noise_force_n: float,
+) -> FloatArray:
+    """A model's variants run from the recording's measured states on its segments.
+
+    Rows: the variants; each u then F over the whole recording, in noise units.
+    """
+    seg = recording.segments
+    rate = recording.rate_hz
+    restarts = seg.restarts_ahead(_lead_samples(effects, rate))
+    u, f = Model(stand, effects).run_segments(recording.x_m, rate, restarts, variants)
+    return np.concatenate([seg.assemble(u) / noise_u_m, seg.assemble(f) / noise_force_n], 1)
+
+
+def _beyond(difference: FloatArray, steps: FloatArray) -> FloatArray:
+    """``difference`` less what the rows of ``steps`` span (a refit), by least squares."""
+    if not steps.size:
+        return difference
+    columns = np.asarray(steps.T, dtype=np.float64)
+    beyond: FloatArray = difference - columns @ np.linalg.lstsq(columns, difference, rcond=None)[0]
+    return beyond
+
+
+def _channel_rms(stacked: FloatArray, n: int, samples: NDArray[np.bool_]) -> tuple[float, float]:
+    """RMS of u and of F (stacked: u's n values, then F's) over the selected samples."""
+    rms = [float(np.sqrt(np.mean(stacked[c * n : (c + 1) * n][samples] ** 2))) for c in (0, 1)]
+    return rms[0], rms[1]
+
+
+def _recorded(recording: Trace, noise_u_m: float, noise_force_n: float) -> FloatArray:
+    """The recording's u then F, in noise units."""
+    return np.concatenate([recording.u_m / noise_u_m, recording.force_n / noise_force_n])
+
+
 def shooting_separation(
     recording: Trace,
     stand: StandParams,
@@ -174,31 +211,17 @@ def shooting_separation(
     at its fitted values; ``truth``, ``model``: the effects on top of it. Noise units:
     ``noise_u_m`` and ``noise_force_n`` (rms).
     """
-    seg = recording.segments
-    rate = recording.rate_hz
-
-    def runs(effects: Sequence[EffectSpec], variants: list[Variant]) -> FloatArray:
-        restarts = seg.restarts_ahead(_lead_samples(effects, rate))
-        u, f = Model(stand, effects).run_segments(recording.x_m, rate, restarts, variants)
-        return np.concatenate([seg.assemble(u) / noise_u_m, seg.assemble(f) / noise_force_n], 1)
-
-    target = runs(truth, [{}])[0]
-    z = runs(model, [{}, *baseline_steps(stand), *effect_steps(model)])
-    directions = np.asarray((z[1:] - z[0]).T, dtype=np.float64)
-    miss = target - z[0]
-    if directions.size:
-        miss = miss - directions @ np.linalg.lstsq(directions, miss, rcond=None)[0]
-    data = np.concatenate([recording.u_m / noise_u_m, recording.force_n / noise_force_n])
+    noise = (noise_u_m, noise_force_n)
+    target = _segment_runs(recording, stand, truth, [{}], *noise)[0]
+    variants = [{}, *baseline_steps(stand), *effect_steps(model)]
+    z = _segment_runs(recording, stand, model, variants, *noise)
+    miss = _beyond(target - z[0], z[1:] - z[0])
     n = recording.samples
     judged = recording.test if recording.test.any() else recording.present
-    channel_miss, channel_floor = [], []
-    for c in range(2):
-        part = slice(c * n, (c + 1) * n)
-        channel_miss.append(float(np.sqrt(np.mean(miss[part][judged] ** 2))))
-        off = data[part][judged] - target[part][judged]
-        channel_floor.append(float(np.sqrt(np.mean(off**2))))
+    channel_miss = _channel_rms(miss, n, judged)
+    channel_floor = _channel_rms(_recorded(recording, *noise) - target, n, judged)
     beyond = float(np.sqrt(2.0 * np.mean(miss**2)))
-    return Miss(beyond, (channel_miss[0], channel_miss[1]), (channel_floor[0], channel_floor[1]))
+    return Miss(beyond, channel_miss, channel_floor)
 
 
 def parameter_information(
@@ -226,25 +249,16 @@ def parameter_information(
         raise ValueError(f"{key} is not a fitted parameter of {[e.name for e in effects]}")
     effect, name = key.split(".", 1)
     value = next(spec for spec in effects if spec.name == effect).resolved()[name]
-    seg = recording.segments
-    rate = recording.rate_hz
-    restarts = seg.restarts_ahead(_lead_samples(effects, rate))
     others = [s for s in steps if key not in s]
-    u, f = Model(stand, effects).run_segments(
-        recording.x_m, rate, restarts, [{}, own, *baseline_steps(stand), *others]
-    )
-    z = np.concatenate([seg.assemble(u) / noise_u_m, seg.assemble(f) / noise_force_n], 1)
-    slope = (z[1] - z[0]) / (own[key] - value)
-    directions = np.asarray((z[2:] - z[0]).T, dtype=np.float64)
-    if directions.size:
-        slope = slope - directions @ np.linalg.lstsq(directions, slope, rcond=None)[0]
-    data = np.concatenate([recording.u_m / noise_u_m, recording.force_n / noise_force_n])
+    variants = [{}, own, *baseline_steps(stand), *others]
+    z = _segment_runs(recording, stand, effects, variants, noise_u_m, noise_force_n)
+    slope = _beyond((z[1] - z[0]) / (own[key] - value), z[2:] - z[0])
+    off = _recorded(recording, noise_u_m, noise_force_n) - z[0]
     n = recording.samples
-    used = recording.present
     information = 0.0
-    for c in range(2):
+    for c in (0, 1):
         part = slice(c * n, (c + 1) * n)
-        ok = used & np.isfinite(data[part]) & np.isfinite(slope[part])
-        floor = float(np.sqrt(np.mean((data[part][ok] - z[0][part][ok]) ** 2)))
+        ok = recording.present & np.isfinite(off[part]) & np.isfinite(slope[part])
+        floor = float(np.sqrt(np.mean(off[part][ok] ** 2)))
         information += float(np.sum(slope[part][ok] ** 2)) / max(floor, 1.0) ** 2
     return information
