@@ -86,11 +86,6 @@ class Remainder:
     own: OwnExcess | None = None
 
     @property
-    def gross(self) -> bool:
-        """Beyond what the fitted model leaves on its own recordings."""
-        return self.own is not None and self.own.gross
-
-    @property
     def state(self) -> str:
         """What remains, in words (the CLI's and the report's)."""
         if not self.beyond_noise:

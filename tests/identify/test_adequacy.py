@@ -76,12 +76,12 @@ def test_a_gross_misfit_that_no_signature_repeats_is_not_called_adequate(
             out.force_n[at] += rng.normal(0.0, 40.0 * tr.noise_force_n)
     excess = heldout_excess(traces, outputs)
     remainder, _ = remainder_of(traces, outputs, nominal, truth, excess, candidate=base)
-    assert remainder.gross and remainder.beyond_noise
+    assert remainder.own is not None and remainder.own.gross and remainder.beyond_noise
     assert verdict(False, remainder) == "unexplained"
     assert "too few, or the misfit too irregular" in remainder.state
     # Where effects are named the comparison is reported, and the signatures decide.
     beside, _ = remainder_of(traces, outputs, nominal, truth, excess, candidate=base, named=True)
-    assert beside.gross and beside.own is not None
+    assert beside.own is not None and beside.own.gross
     assert beside.beyond_noise == any(s.passes for s in beside.signature)
     alone, _ = remainder_of(traces, outputs, nominal, truth, excess)
     if not any(s.passes for s in alone.signature):
