@@ -121,7 +121,7 @@ def narrowing_for(
     """The interval the plan narrows second, with what the recordings hold about it."""
     from sim.discrimination import effect_steps, parameter_information
     from sim.planner import Narrowing
-    from sim.prediction import corner_variants
+    from sim.prediction import centre_stand
 
     refitted = {key for step in effect_steps(fitted.effects) for key in step}
     widest = widest_interval(fitted, refitted.__contains__)
@@ -130,8 +130,7 @@ def narrowing_for(
     key, value, interval = widest
     held = 0.0
     for tr in traces:
-        stand = config.stand_params("final", tr.mass_kg)
-        stand = stand.with_(**corner_variants(stand, fitted.spread())[0])
+        stand = centre_stand(config.stand_params("final", tr.mass_kg), fitted.spread())
         held += parameter_information(tr, stand, fitted.effects, key, noise.u_m, noise.force_n)
     return Narrowing(fitted.effects[0].name, key, value, interval, held if traces else None)
 

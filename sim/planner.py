@@ -44,7 +44,7 @@ from sim.identify.traces import Trace
 from sim.model import BatchResult, Model
 from sim.motions import Candidate, lengthened, motion_grid, padded
 from sim.params import StandParams
-from sim.prediction import corner_variants
+from sim.prediction import centre_stand, corner_variants
 
 __all__ = [
     "DECISIVE",
@@ -364,9 +364,7 @@ def _judge(setting: Setting, mass: float, group: Sequence[Candidate]) -> list[_J
     if not ok:
         return []
     runs = _rival_runs(setting, mass, x[ok])
-    stand = setting.nominal.with_(mass_kg=mass)
-    centre = corner_variants(stand, setting.spread)[0]
-    fitted = stand.with_(**centre)
+    fitted = centre_stand(setting.nominal.with_(mass_kg=mass), setting.spread)
     found = []
     for j, i in enumerate(ok):
         n, pred = lengths[i], predictions[i]

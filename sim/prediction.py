@@ -18,7 +18,7 @@ from sim.envelope import Prediction, Spread, figures_of, worst_of
 from sim.model import Model, Variant
 from sim.params import StandParams
 
-__all__ = ["corner_variants", "predict"]
+__all__ = ["centre_stand", "corner_variants", "predict"]
 
 
 def corner_variants(stand: StandParams, spread: Spread) -> list[Variant]:
@@ -31,6 +31,11 @@ def corner_variants(stand: StandParams, spread: Spread) -> list[Variant]:
         }
         for k, c, f in spread.corners()
     ]
+
+
+def centre_stand(stand: StandParams, spread: Spread) -> StandParams:
+    """``stand`` at the spread's centre: the fitted stand the planner's rivals stand on."""
+    return stand.with_(**corner_variants(stand, spread)[0])
 
 
 def predict(
