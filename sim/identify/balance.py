@@ -115,6 +115,7 @@ class _Equations:
 
     u: FloatArray
     v: FloatArray
+    x: FloatArray
     force: FloatArray
     e: FloatArray
     e_rate: FloatArray
@@ -144,7 +145,7 @@ def _equations(
     )
     g = force - (k * e + c * e_rate)
     f = tr.mass_kg * a - n * force + nominal.gravity_along_n + friction
-    return _Equations(u, v, force, e, e_rate, friction, g, f)
+    return _Equations(u, v, x, force, e, e_rate, friction, g, f)
 
 
 def _near(marks: BoolArray, reach: int) -> BoolArray:
@@ -161,7 +162,8 @@ def _balances(
     derivatives bend a snatch, the two spans and the pulley are one spring here, and the
     dial's scale is an estimate (off by 5·10⁻⁵, the stiff fibre turns it into 0.8 N·u/span
     in g). On the model's own recordings with noise alone, a position term then passed
-    at p 0.0004 and a resonance term closed 15–18 % of g at p 0.003–0.03. What the model
+    at p 0.0004; with the scale refitted beside k and c instead, a resonance term
+    closing 15–18 % of g passed at p 0.003–0.03. What the model
     leaves in the balances through the same steps is no missing force; its difference to
     the recorded one is. Around each segment restart (the runs join there with a step)
     the model's balance is not used.
@@ -170,7 +172,6 @@ def _balances(
     spikes = _spikes(tr.force_n, tr.noise_force_n)
     rec = _equations(tr, tr.u_m, np.where(spikes, np.nan, tr.force_n), nominal, values)
     own = _equations(tr, model.u_m, model.force_n, nominal, values)
-    x = _lowpass(tr.x_m - tr.x_m[0], rate)
     g, f = rec.g - own.g, rec.f - own.f
     # Lost samples and spikes were bridged before the low-pass: their neighbourhood is
     # interpolation, not measurement; a restart's step rings through the low-pass.
@@ -186,7 +187,7 @@ def _balances(
     noise_g = float(np.std(g[rest])) or 1.0
     noise_f = float(np.std(f[rest])) or 1.0
     tension = _lowpass(model.force_n, rate)
-    return _Balances(rec.u, rec.v, x, rec.force, tension, rec.e, rec.e_rate, rec.friction,
+    return _Balances(rec.u, rec.v, rec.x, rec.force, tension, rec.e, rec.e_rate, rec.friction,
                      g, f, use_g, use_f, noise_g, noise_f)  # fmt: skip
 
 

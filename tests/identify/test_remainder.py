@@ -125,8 +125,8 @@ def test_the_model_s_own_recordings_leave_no_missing_force_in_the_balances(
     # scale as estimated from a live recording (5·10⁻⁵ off) or exact. What the low-pass,
     # the derivatives, the one-spring fibre law and the scale leave in the balances is
     # the model's as much as the recording's: no term may pass for a missing force
-    # (before the model's own balances were taken off, a position term passed at p 0.0004
-    # with the scale off, and a resonance term closed 15-18 % of the fibre's balance).
+    # (before the model's own balances were taken off, a position term passed here with
+    # the scale off).
     nominal = stand.stand_params("final", HEAVY)
     base = Candidate.build()
     values = {"stiffness_scale": 1.0, "damping_scale": 1.0, "friction_scale": 1.0}
