@@ -49,8 +49,10 @@ def remainder_section(result: Diagnosis, plotted: bool) -> str:
     if rem is None:
         return f'<h2 id="remainder">What remains</h2><p>{NOT_COMPUTED}.</p>'
     state = html.escape(rem.state)
+    fitted_to = {"outputs": "the model's outputs", "balances": "the balances"}
     rows = "".join(
         f"<tr><td>{html.escape(s.kind)}</td><td>{html.escape(s.channel)}</td>"
+        f"<td>{html.escape(fitted_to.get(s.source, s.source))}</td>"
         f"<td>{s.closes:.0%}</td><td>{s.p_family:.2g}</td><td>{'yes' if s.passes else 'no'}</td>"
         f"<td><code>{html.escape(s.formula)}</code></td></tr>"
         for s in rem.signature
@@ -64,7 +66,8 @@ def remainder_section(result: Diagnosis, plotted: bool) -> str:
 <p><b>{html.escape(VERDICT_WORDS.get(result.verdict, result.verdict))}</b>.
 The remainder is {state} (family p = {rem.p_value:.2g} over the signature kinds); its
 held-out error is {rem.excess:.2f} × the noise, {rem.share_of_gap:.0%} of the baseline's gap.</p>
-<table><tr><th>kind</th><th>acts in</th><th>closes of the remainder</th><th>p (family)</th>
+<table><tr><th>kind</th><th>acts in</th><th>fitted to</th>
+<th>closes (of the remainder; of a balance's error)</th><th>p (family)</th>
 <th>evidence</th><th>fitted terms</th></tr>{rows}</table>
 {plot}"""
 

@@ -9,9 +9,10 @@ import numpy as np
 
 from labstand.plots import pyplot
 from sim.identify import Diagnosis, Trace
+from sim.identify.signature import Signature
 from sim.identify.traces import PHASES
 
-__all__ = ["overlay_plot", "remainder_plot", "residual_plot"]
+__all__ = ["balance_plot", "overlay_plot", "remainder_plot", "residual_plot"]
 
 PHASE_COLOURS = {"rise": "tab:red", "hold": "tab:orange", "fall": "tab:blue", "rest": "tab:gray"}
 #: A recording's name in a panel title, at most this many characters (the title stays
@@ -153,11 +154,16 @@ def remainder_plot(path: Path, traces: Sequence[Trace], result: Diagnosis) -> bo
     in grey, the signature's fit in colour, held-out cycles shaded.
     """
     rem = result.remainder
-    # The model's outputs' signatures: the balances' describe forces, not these channels.
-    passing = (
-        [s for s in rem.signature if s.passes and s.source == "outputs"] if rem is not None else []
-    )
+    passing = [s for s in rem.signature if s.passes] if rem is not None else []
     if rem is None or not passing:
+        return False
+    if passing[0].source == "balances" and passing[0].series:
+        # The answer's kind came from the balances: show the force it describes.
+        balance_plot(path, passing[0])
+        return True
+    # The model's outputs' signatures: the balances' describe forces, not these channels.
+    passing = [s for s in passing if s.source == "outputs"]
+    if not passing:
         return False
     best = passing[0]
     fit = rem.fits[f"{best.kind} in {best.channel}"]
@@ -195,3 +201,65 @@ def remainder_plot(path: Path, traces: Sequence[Trace], result: Diagnosis) -> bo
     fig.savefig(path, dpi=100)
     plt.close(fig)
     return True
+
+
+#: The balance's running mean in the plot, s: the noise above the low-pass averaged out.
+SMOOTH_S = 0.1
+
+
+def _running_mean(values: np.ndarray, where: np.ndarray, width: int) -> np.ndarray:
+    """Mean of ``values`` over ``width`` samples, counting only ``where``; NaN outside it."""
+    kernel = np.ones(max(width, 1))
+    total = np.convolve(np.where(where, values, 0.0), kernel, mode="same")
+    count = np.convolve(where.astype(float), kernel, mode="same")
+    mean = total / np.maximum(count, 1.0)
+    return np.where(where & (count > 0.5 * kernel.size), mean, np.nan)
+
+
+#: The two balances as the plot names them: (series, its term, where it holds, label).
+_BALANCES = (
+    ("tension", "tension_term", "taut", "missing tension [N]"),
+    ("weight", "weight_term", "sliding", "missing force on the weight [N]"),
+)
+
+
+def balance_plot(path: Path, signature: Signature) -> None:
+    """A balances' signature: per recording, the balance it acts in against its fit.
+
+    Grey: the balance (the recorded one less the model's own, less the baseline's own
+    terms) where it holds; colour: the signature's terms; held-out cycles shaded.
+    """
+    rows = []
+    for part in signature.series:
+        for series, term, held, label in _BALANCES:
+            if np.any(getattr(part, term)[getattr(part, held)] != 0.0):
+                rows.append((part, series, term, held, label))
+    plt = pyplot()
+    fig, axes = plt.subplots(
+        max(len(rows), 1), 1, figsize=(11, 2.4 * max(len(rows), 1) + 0.8),
+        squeeze=False, layout="constrained",
+    )  # fmt: skip
+    for ax, (part, series, term, held, label) in zip(axes[:, 0], rows, strict=False):
+        t = np.arange(part.train.size) / part.rate_hz
+        where = getattr(part, held)
+        values = getattr(part, series)
+        ax.plot(t, np.where(where, values, np.nan), color="0.6", lw=0.5,
+                label="balance (recorded − model)")  # fmt: skip
+        ax.plot(t, _running_mean(values, where, int(SMOOTH_S * part.rate_hz)), color="k",
+                lw=0.8, label=f"its mean over {SMOOTH_S * 1e3:.0f} ms")  # fmt: skip
+        ax.plot(t, np.where(where, getattr(part, term), np.nan), color="tab:red", lw=1.0,
+                label=f"{signature.kind} term")  # fmt: skip
+        low, high = ax.get_ylim()
+        ax.fill_between(t, low, high, where=~part.train, color="k", alpha=0.06,
+                        label="held out")  # fmt: skip
+        ax.set_ylim(low, high)
+        ax.set_ylabel(label, fontsize=9)
+        ax.set_title(short_name(part.name), fontsize=10, loc="left")
+        ax.grid(alpha=0.3)
+    axes[-1, 0].set_xlabel("time [s]")
+    handles, labels = axes[0, 0].get_legend_handles_labels()
+    fig.suptitle(f"{signature.kind} in {signature.channel}, from the balances: "
+                 f"{short_name(signature.formula, 110)}", fontsize=10)  # fmt: skip
+    fig.legend(handles, labels, loc="outside lower center", ncol=4, fontsize=10)
+    fig.savefig(path, dpi=100)
+    plt.close(fig)

@@ -36,6 +36,7 @@ from sim.identify.signature import (
     POSITION_ORDERS,
     THRESHOLD_NOISE,
     VELOCITY_SCALES_M_S,
+    BalanceSeries,
     _legendre,
     _mode_response,
     stlsq,
@@ -317,6 +318,8 @@ class BalanceFit:
     after: FloatArray
     #: How well the balances' noise unit is known, as a share (``noise_resolution``).
     resolution: float = 0.1
+    #: Per recording: the balances after the baseline's own terms and the term's fit.
+    series: tuple[BalanceSeries, ...] = ()
 
     @property
     def name(self) -> str:
@@ -371,14 +374,26 @@ def fit_balances(
             coef = stlsq(stacked.T, target, THRESHOLD_NOISE, always)
             mine = np.zeros(len(names))
             mine[rows] = coef[: int(rows.sum())]
-            after = _block_errors(
-                traces, balances, library, kind, mine, base_coef=coef[int(rows.sum()) :]
-            )
+            own_base = coef[int(rows.sum()) :]
+            after = _block_errors(traces, balances, library, kind, mine, base_coef=own_base)
             formula = " + ".join(_text(c, w) for c, w in zip(names, mine, strict=True) if w != 0.0)
-            fits.append(
-                BalanceFit(kind, channel, formula or "0", before, after, noise_resolution(traces))
-            )
+            series = tuple(_series(library, kind, i, mine, own_base) for i in range(len(traces)))
+            fits.append(BalanceFit(kind, channel, formula or "0", before, after,
+                                   noise_resolution(traces), series))  # fmt: skip
     return fits
+
+
+def _series(
+    library: _BalanceLibrary, kind: str, i: int, coef: FloatArray, base_coef: FloatArray
+) -> BalanceSeries:
+    """Trace ``i``'s balances less the baseline's own terms, and the kind's fit, N."""
+    tr, b = library.traces[i], library.balances[i]
+    _, g_cols, f_cols = library.columns(kind, i)
+    _, bg, bf = library.columns("base", i)
+    return BalanceSeries(
+        tr.name, tr.rate_hz, tr.train, b.g - base_coef @ bg, coef @ g_cols, b.use_g,
+        b.f - base_coef @ bf, coef @ f_cols, b.use_f,
+    )  # fmt: skip
 
 
 def noise_resolution(traces: Sequence[Trace]) -> float:

@@ -44,7 +44,7 @@ from sim.identify.decide import (
 )
 from sim.identify.fitting import Candidate
 from sim.identify.heldout import Outputs, heldout_excess
-from sim.identify.signature import Signature, SignatureFit, fit_signatures
+from sim.identify.signature import BalanceSeries, Signature, SignatureFit, fit_signatures
 from sim.identify.traces import Trace
 from sim.identify.where import Where
 from sim.params import StandParams
@@ -136,9 +136,11 @@ def judge_signatures(
     before = dict.fromkeys(names, x_before)
     info = {n: (fits[n].kind, fits[n].channel, fits[n].formula, "outputs") for n in names}
     resolution: dict[str, float] = {}
+    series: dict[str, tuple[BalanceSeries, ...]] = {}
     if balances:
         for fit in fit_balances(traces, outputs, nominal, values):
             resolution[fit.name] = fit.resolution
+            series[fit.name] = fit.series
             names.append(fit.name)
             rows.append(np.log(np.maximum(fit.before, 1e-300) / np.maximum(fit.after, 1e-300)))
             before[fit.name] = float(np.sqrt(np.mean(fit.before)))
@@ -162,6 +164,7 @@ def judge_signatures(
                 p_family=ev.corrected_p(len(names)),
                 passes=_passes(ev, len(names), resolution.get(name)),
                 source=source,
+                series=series.get(name, ()),
             )
         )
     # Passing ones first; among them the balances' (instantaneous: no bounce blurs them)

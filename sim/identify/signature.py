@@ -35,7 +35,7 @@ threshold is in noise units: a term that moves the outputs by less than
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import lru_cache
 
 import numpy as np
@@ -99,6 +99,26 @@ class Term:
 
 
 @dataclass(frozen=True)
+class BalanceSeries:
+    """One recording's balances after the baseline's own terms, and a term's fit, N.
+
+    ``tension``: the fibre's law (a missing tension), ``weight``: the weight's balance
+    (a missing force on it); each with the term's share of it and the samples where
+    that balance holds (a taut fibre; a sliding weight).
+    """
+
+    name: str
+    rate_hz: float
+    train: NDArray[np.bool_]
+    tension: FloatArray
+    tension_term: FloatArray
+    taut: NDArray[np.bool_]
+    weight: FloatArray
+    weight_term: FloatArray
+    sliding: NDArray[np.bool_]
+
+
+@dataclass(frozen=True)
 class Signature:
     """A kind of term that describes the remainder: its formula and what it closes."""
 
@@ -113,6 +133,8 @@ class Signature:
     passes: bool = False
     #: Where it was fitted: the model's held-out ``outputs``, or the force ``balances``.
     source: str = "outputs"
+    #: The balances' series behind it, per recording (for the report's plot; balances only).
+    series: tuple[BalanceSeries, ...] = field(default=(), repr=False, compare=False)
 
     def to_dict(self) -> dict[str, object]:
         """JSON keys kind, channel, formula, closes, excess_after, p_value, passes, source."""

@@ -89,10 +89,16 @@ def test_a_drifting_force_zero_is_described_as_drift_in_the_force_channel(
     # In the model's outputs too, where it closes most of the remainder.
     outputs = next(s for s in passing if s.source == "outputs" and s.kind == "drift")
     assert outputs.channel == "F" and outputs.closes > 0.5
-    # The report shows it: the remainder against the drift term's fit.
+    # The report shows it: the balance it was found in against the drift term's fit.
+    best = passing[0].series
+    assert [part.name for part in best] == [tr.name for tr in traces]
+    assert all(part.tension.size == tr.samples for part, tr in zip(best, traces, strict=True))
+    drift_in_tension = np.concatenate([p.tension_term[p.taut] for p in best])
+    assert np.ptp(drift_in_tension) > 0.5  # the 1.2 N drift, seen in the fibre's law
     index = write_report(tmp_path / "report", traces, result)
     assert (tmp_path / "report" / "remainder.png").stat().st_size > 0
-    assert "unexplained" in index.read_text(encoding="utf-8")
+    page = index.read_text(encoding="utf-8")
+    assert "unexplained" in page and "the balances" in page
 
 
 @pytest.mark.parametrize("noise_scale", [0.3, 1.0, 3.0])
