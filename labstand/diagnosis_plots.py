@@ -151,16 +151,15 @@ def remainder_plot(path: Path, traces: Sequence[Trace], result: Diagnosis) -> bo
     """The final model's remainder against what its best signature predicts (False: none).
 
     Per recording, each channel the signature acts in: the remainder (recorded − model)
-    in grey, the signature's fit in colour, held-out cycles shaded.
+    in grey, the signature's fit in colour, held-out cycles shaded; where the best is the
+    balances', the balance it acts in instead (``balance_plot``).
     """
     rem = result.remainder
     passing = [s for s in rem.signature if s.passes] if rem is not None else []
     if rem is None or not passing:
         return False
-    if passing[0].source == "balances" and passing[0].series:
-        # The answer's kind came from the balances: show the force it describes.
-        balance_plot(path, passing[0])
-        return True
+    if passing[0].source == "balances" and balance_plot(path, passing[0]):
+        return True  # the answer's kind came from the balances: the force it describes
     # The model's outputs' signatures: the balances' describe forces, not these channels.
     passing = [s for s in passing if s.source == "outputs"]
     if not passing:
@@ -223,23 +222,25 @@ _BALANCES = (
 )
 
 
-def balance_plot(path: Path, signature: Signature) -> None:
+def balance_plot(path: Path, signature: Signature) -> bool:
     """A balances' signature: per recording, the balance it acts in against its fit.
 
     Grey: the balance (the recorded one less the model's own, less the baseline's own
     terms) where it holds; colour: the signature's terms; held-out cycles shaded.
+    False (nothing drawn) where its terms vanish wherever a balance holds.
     """
     rows = []
     for part in signature.series:
         for series, term, held, label in _BALANCES:
             if np.any(getattr(part, term)[getattr(part, held)] != 0.0):
                 rows.append((part, series, term, held, label))
+    if not rows:
+        return False
     plt = pyplot()
     fig, axes = plt.subplots(
-        max(len(rows), 1), 1, figsize=(11, 2.4 * max(len(rows), 1) + 0.8),
-        squeeze=False, layout="constrained",
-    )  # fmt: skip
-    for ax, (part, series, term, held, label) in zip(axes[:, 0], rows, strict=False):
+        len(rows), 1, figsize=(11, 2.4 * len(rows) + 0.8), squeeze=False, layout="constrained"
+    )
+    for ax, (part, series, term, held, label) in zip(axes[:, 0], rows, strict=True):
         t = np.arange(part.train.size) / part.rate_hz
         where = getattr(part, held)
         values = getattr(part, series)
@@ -263,3 +264,4 @@ def balance_plot(path: Path, signature: Signature) -> None:
     fig.legend(handles, labels, loc="outside lower center", ncol=4, fontsize=10)
     fig.savefig(path, dpi=100)
     plt.close(fig)
+    return True
