@@ -7,7 +7,7 @@ from collections.abc import Mapping
 from typing import Any
 
 from labstand.diagnosis_charts import CLIP_CLOSURE
-from labstand.diagnosis_html import NOT_COMPUTED, interval_text, number
+from labstand.diagnosis_html import FITTED_TO, NOT_COMPUTED, interval_text, number
 from sim.identify import Diagnosis
 
 __all__ = [
@@ -49,10 +49,9 @@ def remainder_section(result: Diagnosis, plotted: bool) -> str:
     if rem is None:
         return f'<h2 id="remainder">What remains</h2><p>{NOT_COMPUTED}.</p>'
     state = html.escape(rem.state)
-    fitted_to = {"outputs": "the model's outputs", "balances": "the balances"}
     rows = "".join(
         f"<tr><td>{html.escape(s.kind)}</td><td>{html.escape(s.channel)}</td>"
-        f"<td>{html.escape(fitted_to.get(s.source, s.source))}</td>"
+        f"<td>{html.escape(FITTED_TO.get(s.source, s.source))}</td>"
         f"<td>{s.closes:.0%}</td><td>{s.p_family:.2g}</td><td>{'yes' if s.passes else 'no'}</td>"
         f"<td><code>{html.escape(s.formula)}</code></td></tr>"
         for s in rem.signature

@@ -21,6 +21,8 @@ __all__ = ["first_screen", "interval_text", "number"]
 #: The channels in words (the page's reader may not know u and F).
 CHANNEL_WORDS = {"u": "u, weight displacement", "F": "F, fibre force"}
 NOT_COMPUTED = "not computed"
+#: What a remainder signature was fitted to, in words (``Signature.source``).
+FITTED_TO = {"outputs": "the model's outputs", "balances": "the balances"}
 
 
 def number(value: object, digits: int = 4) -> str:
@@ -111,8 +113,16 @@ def _which(result: Diagnosis) -> str:
     rem = result.remainder
     if rem is not None:
         state = html.escape(rem.state)
+        passing = [s for s in rem.signature if s.passes]
+        like = (
+            f"; it behaves like a {html.escape(passing[0].kind)} term in "
+            f"{html.escape(passing[0].channel)} (fitted to "
+            f"{html.escape(FITTED_TO.get(passing[0].source, passing[0].source))})"
+            if passing
+            else ""
+        )
         parts.append(
-            f"<li>What remains is {state} (family p = {number(rem.p_value, 2)}): "
+            f"<li>What remains is {state} (family p = {number(rem.p_value, 2)}){like}: "
             f'<a href="#remainder">details</a>.</li>'
         )
     parts.append(f"</ul><p class=\"muted\">Family p: the candidates' joint test on held-out "

@@ -99,6 +99,7 @@ def test_a_drifting_force_zero_is_described_as_drift_in_the_force_channel(
     assert (tmp_path / "report" / "remainder.png").stat().st_size > 0
     page = index.read_text(encoding="utf-8")
     assert "unexplained" in page and "the balances" in page
+    assert "behaves like a drift term in F (fitted to the balances)" in page  # first screen
 
 
 @pytest.mark.parametrize("noise_scale", [0.3, 1.0, 3.0])
