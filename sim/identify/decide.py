@@ -36,7 +36,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.stats import rankdata, wilcoxon
 
-from sim.identify.heldout import Outputs, block_errors, heldout_excess
+from sim.identify.heldout import CHANNELS, Outputs, block_errors, heldout_excess
 from sim.identify.traces import Trace
 
 #: Family-wise false-alarm rate of one decision (after the Bonferroni correction): a
@@ -120,7 +120,10 @@ def p_value_of_gains(gains: np.ndarray) -> float:
 
 
 def block_gains(
-    traces: Sequence[Trace], before: Sequence[Outputs], after: Sequence[Outputs]
+    traces: Sequence[Trace],
+    before: Sequence[Outputs],
+    after: Sequence[Outputs],
+    channels: Sequence[str] = CHANNELS,
 ) -> np.ndarray:
     """Per held-out block: the log of the error ratio, before over after (> 0: better).
 
@@ -130,18 +133,24 @@ def block_gains(
     which drowned a candidate's consistent threefold gain on every other trace (absolute
     gains: p = 0.18 after the correction, relative: see docs/diagnosis.md, "The decision").
     """
-    eb, ea = block_errors(traces, before, after)
+    eb, ea = block_errors(traces, before, after, channels=channels)
     return np.log(np.maximum(eb, 1e-300) / np.maximum(ea, 1e-300))
 
 
 def compare(
-    traces: Sequence[Trace], before: Sequence[Outputs], after: Sequence[Outputs]
+    traces: Sequence[Trace],
+    before: Sequence[Outputs],
+    after: Sequence[Outputs],
+    channels: Sequence[str] = CHANNELS,
 ) -> Evidence:
-    """The held-out evidence that ``after`` predicts better than ``before`` (alone)."""
-    gains = block_gains(traces, before, after)
+    """The held-out evidence that ``after`` predicts better than ``before`` (alone).
+
+    ``channels``: the recorded channels judged (both by default).
+    """
+    gains = block_gains(traces, before, after, channels)
     return Evidence(
-        x_before=heldout_excess(traces, before),
-        x_after=heldout_excess(traces, after),
+        x_before=heldout_excess(traces, before, channels),
+        x_after=heldout_excess(traces, after, channels),
         p_value=p_value_of_gains(gains),
         blocks=int(gains.size),
     )

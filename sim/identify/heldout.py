@@ -16,6 +16,8 @@ FloatArray = NDArray[np.float64]
 
 #: A channel's noise counts as at least this share of its spread (see _noise_scale).
 NOISE_FLOOR_SHARE = 1e-4
+#: The recorded channels: the displacement gauge's and the force gauge's.
+CHANNELS = ("u", "F")
 
 
 @dataclass(frozen=True)
@@ -26,15 +28,22 @@ class Outputs:
     force_n: FloatArray
 
 
-def _test_parts(trace: Trace, out: Outputs) -> list[tuple[FloatArray, FloatArray, float]]:
+def _channel_parts(
+    trace: Trace, out: Outputs, channels: Sequence[str] = CHANNELS
+) -> list[tuple[FloatArray, FloatArray, float]]:
+    """Per channel asked for: the whole recorded signal, the model's, the gauge's noise."""
+    parts = {
+        "u": (trace.u_m, out.u_m, trace.noise_u_m),
+        "F": (trace.force_n, out.force_n, trace.noise_force_n),
+    }
+    return [parts[c] for c in channels]
+
+
+def _test_parts(
+    trace: Trace, out: Outputs, channels: Sequence[str] = CHANNELS
+) -> list[tuple[FloatArray, FloatArray, float]]:
     idx = trace.test
-    parts = []
-    for rec, sim, noise in (
-        (trace.u_m, out.u_m, trace.noise_u_m),
-        (trace.force_n, out.force_n, trace.noise_force_n),
-    ):
-        parts.append((rec[idx], sim[idx], noise))
-    return parts
+    return [(rec[idx], sim[idx], noise) for rec, sim, noise in _channel_parts(trace, out, channels)]
 
 
 def heldout_error(traces: Sequence[Trace], outputs: Sequence[Outputs]) -> float:
@@ -85,7 +94,9 @@ def _noise_scale(rec: FloatArray, noise: float) -> float:
     return max(noise, NOISE_FLOOR_SHARE * float(np.std(rec)), 1e-300)
 
 
-def heldout_excess(traces: Sequence[Trace], outputs: Sequence[Outputs]) -> float:
+def heldout_excess(
+    traces: Sequence[Trace], outputs: Sequence[Outputs], channels: Sequence[str] = CHANNELS
+) -> float:
     """Held-out rms error in units of each channel's noise, pooled over traces and channels.
 
     1 is a perfect model. This is what decides between candidates: each channel counts
@@ -102,7 +113,7 @@ def heldout_excess(traces: Sequence[Trace], outputs: Sequence[Outputs]) -> float
     """
     logs = []
     for tr, out in zip(traces, outputs, strict=True):
-        for rec, sim, noise in _test_parts(tr, out):
+        for rec, sim, noise in _test_parts(tr, out, channels):
             scale = _noise_scale(rec, noise)
             rms = float(np.sqrt(np.mean((sim - rec) ** 2)))
             logs.append(math.log(max(rms / scale, 1e-300)))
@@ -121,28 +132,28 @@ def block_errors(
     before: Sequence[Outputs],
     after: Sequence[Outputs],
     block_s: float = BLOCK_S,
+    channels: Sequence[str] = CHANNELS,
 ) -> tuple[FloatArray, FloatArray]:
     """Per held-out block: mean squared error in noise units, before and after.
 
     Held-out cycles are cut into blocks of about ``block_s`` (at least one per cycle):
     long enough that a block's errors are nearly independent of its neighbours' (the
     fibre's ringing dies out within a tenth of a second), short enough that a campaign
-    with few held-out cycles still gives a test some power. Both channels are summed,
+    with few held-out cycles still gives a test some power. The ``channels`` are summed,
     each over its own noise.
     """
     errors: list[tuple[float, float]] = []
     for tr, b, a in zip(traces, before, after, strict=True):
         idx = tr.test
-        scales = [
-            _noise_scale(tr.u_m[idx], tr.noise_u_m),
-            _noise_scale(tr.force_n[idx], tr.noise_force_n),
+        parts = [
+            (rec, sb, sa, _noise_scale(rec[idx], noise))
+            for (rec, sb, noise), (_, sa, _) in zip(
+                _channel_parts(tr, b, channels), _channel_parts(tr, a, channels), strict=True
+            )
         ]
         for sel in held_out_blocks(tr, block_s):
             eb, ea = 0.0, 0.0
-            for rec, sb, sa, scale in (
-                (tr.u_m, b.u_m, a.u_m, scales[0]),
-                (tr.force_n, b.force_n, a.force_n, scales[1]),
-            ):
+            for rec, sb, sa, scale in parts:
                 eb += float(np.mean((sb[sel] - rec[sel]) ** 2)) / scale**2
                 ea += float(np.mean((sa[sel] - rec[sel]) ** 2)) / scale**2
             errors.append((eb, ea))

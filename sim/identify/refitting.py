@@ -13,10 +13,14 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import cast
 
+import numpy as np
+
 from sim.effects import EFFECTS
 from sim.identify.fitting import (
     Candidate,
     FitResult,
+    Objective,
+    effect_grid_points,
     effect_grid_start,
     fit,
     least_cost_values,
@@ -170,8 +174,12 @@ def refine_form(
 
 
 def polish(fitted: Fitted, traces: Sequence[Trace], nominal: StandParams) -> Fitted:
-    """More evaluations for an accepted candidate; kept only if the training cost falls."""
-    res = fitted.result
+    """More evaluations for an accepted candidate; kept only if the training cost falls.
+
+    Each named effect's start grid is tried again first (``grid_again``), at the
+    baseline the fit has now.
+    """
+    res, spent = grid_again(fitted.result, traces, nominal)
     polished = fit(
         res.candidate,
         traces,
@@ -180,11 +188,44 @@ def polish(fitted: Fitted, traces: Sequence[Trace], nominal: StandParams) -> Fit
         single_start=True,
         max_nfev=POLISH_EVALUATIONS,
     )
-    # Judged on the training cycles only; the held-out ones then say how far.
+    spent += polished.evaluations
     if polished.train_cost >= res.train_cost:
-        return fitted
+        polished = res
+    polished = dataclasses.replace(polished, evaluations=spent)
+    # Judged on the training cycles only; the held-out ones then say how far.
+    if polished.train_cost >= fitted.result.train_cost:
+        return Fitted(dataclasses.replace(fitted.result, evaluations=spent), fitted.outputs,
+                      fitted.excess)  # fmt: skip
     outs = outputs_of(polished.candidate, polished.values, traces, nominal)
     return Fitted(polished, outs, heldout_excess(traces, outs))
+
+
+def grid_again(
+    res: FitResult, traces: Sequence[Trace], nominal: StandParams
+) -> tuple[FitResult, int]:
+    """Each effect's start grid again at the fit's other values; a better local fit kept.
+
+    The first grid (``refit``) was laid at the baseline fitted without the effect, whose
+    stiffness, damping and friction had taken some of it; a basin that grid ranked low
+    can be the best at the baseline the fit has now. A heavy pulley's inertia fitted
+    ×0.8 its truth with its bearing torque ×2.4 (training cost 7.5·10⁻⁴, the 95 %
+    intervals holding none of the six parameters); the grid again and one short fit from
+    its best point reached the truth's basin (5.9·10⁻⁴). Returns the fit with the lowest
+    training cost and the simulations spent.
+    """
+    best, spent = res, 0
+    for effect in res.candidate.effects:
+        prefix = f"{effect}."
+        others = {k: v for k, v in best.values.items() if not k.startswith(prefix)}
+        points = effect_grid_points(res.candidate, others)
+        objective = Objective(res.candidate, traces, nominal)
+        costs = np.sum(objective.residuals_batch(points) ** 2, axis=1)
+        again = short_fit(res.candidate, traces, nominal,
+                          res.candidate.natural(points[int(np.argmin(costs))]))  # fmt: skip
+        spent += objective.simulations + again.evaluations
+        if again.train_cost < best.train_cost:
+            best = again
+    return best, spent
 
 
 def closure(x_before: float, x_after: float, x_base: float) -> float:

@@ -15,7 +15,13 @@ from sim.effects.realism import MeasurementNoise, NoiseSpec, draw_real_stand
 from sim.identify import diagnose, make_trace
 from sim.identify.decide import Evidence, family_p_values, p_value_of_gains
 from sim.identify.fitting import FreeParam
-from sim.identify.naming import SECOND_STAGE, beats, second_tries, strongest_accepted
+from sim.identify.naming import (
+    SECOND_STAGE,
+    beats,
+    beyond_reach,
+    second_tries,
+    strongest_accepted,
+)
 from sim.identify.report import Diagnosis, RankedEffect
 from sim.identify.traces import Trace
 from sim.model import Model
@@ -193,6 +199,37 @@ def test_a_runner_up_a_hair_behind_on_every_block_is_not_told_apart(stand: Stand
     assert not beats(traces, chosen, hair)  # … yet no difference X can resolve
     assert beats(traces, chosen, outputs(3.0))
     assert not beats(traces, outputs(3.0), chosen)
+
+
+def test_a_gain_in_a_channel_the_named_forms_cannot_reach_is_judged_there_alone(
+    stand: StandConfig,
+) -> None:
+    # A dial gauge's mismatch of form can only show in u (it reads the weight, it does
+    # not move it): a further effect that a u term matches there, but that also predicts
+    # the force better, explains something the gauge cannot. Judged on both channels
+    # the gain below is diluted by u (equal there); judged on F it is plain.
+    from sim.identify.decide import compare
+    from sim.identify.heldout import Outputs
+
+    traces = _campaign(stand, [], 5) + _campaign(stand, [], 6)
+    rng = np.random.default_rng(5)
+
+    def outputs(u_scale: float, f_scale: float) -> list[Outputs]:
+        return [
+            Outputs(tr.u_m + u_scale * rng.normal(0.0, tr.noise_u_m, tr.samples),
+                    tr.force_n + f_scale * rng.normal(0.0, tr.noise_force_n, tr.samples))
+            for tr in traces
+        ]  # fmt: skip
+
+    named, further = outputs(2.0, 1.6), outputs(2.0, 1.15)
+    assert beats(traces, further, named, ("F",))
+    in_u = compare(traces, named, further, ("u",))
+    assert abs(in_u.gain) < 0.1 and not in_u.accepted(1)
+    assert not beats(traces, named, further, ("F",))
+    assert beyond_reach(("dial_gauge_calibration",)) == ("F",)
+    assert beyond_reach(("channel_time_skew",)) == ("u",)  # a force channel's delay
+    assert beyond_reach(("dial_gauge_calibration", "channel_time_skew")) == ()
+    assert beyond_reach(("fibre_viscoelastic",)) == ()  # the fibre moves both
 
 
 def test_the_best_closure_whose_evidence_holds_is_named_not_only_the_best_closure() -> None:
