@@ -47,6 +47,17 @@ def _campaign(
     return traces
 
 
+def _recorded_plus_noise(
+    traces: list[Trace], rng: np.random.Generator, u_scale: float, f_scale: float
+) -> list[Outputs]:
+    """A model's outputs that miss each channel by that many times its noise (white)."""
+    return [
+        Outputs(tr.u_m + u_scale * rng.normal(0.0, tr.noise_u_m, tr.samples),
+                tr.force_n + f_scale * rng.normal(0.0, tr.noise_force_n, tr.samples))
+        for tr in traces
+    ]  # fmt: skip
+
+
 #: A gauge low-pass at 40 Hz that hides the pulley's inertia and bearing friction.
 GAUGE_AND_PULLEY = [
     EffectSpec("force_gauge_dynamics", {"cutoff_hz": 40.0}),
@@ -210,17 +221,12 @@ def test_a_gain_in_a_channel_the_named_forms_cannot_reach_is_judged_there_alone(
     # the force better, explains something the gauge cannot. Judged on both channels
     # the gain below is diluted by u (equal there); judged on F it is plain.
     from sim.identify.decide import compare
-    from sim.identify.heldout import Outputs
 
     traces = _campaign(stand, [], 5) + _campaign(stand, [], 6)
     rng = np.random.default_rng(5)
 
     def outputs(u_scale: float, f_scale: float) -> list[Outputs]:
-        return [
-            Outputs(tr.u_m + u_scale * rng.normal(0.0, tr.noise_u_m, tr.samples),
-                    tr.force_n + f_scale * rng.normal(0.0, tr.noise_force_n, tr.samples))
-            for tr in traces
-        ]  # fmt: skip
+        return _recorded_plus_noise(traces, rng, u_scale, f_scale)
 
     named, further = outputs(2.0, 1.6), outputs(2.0, 1.15)
     assert beats(traces, further, named, ("F",))
@@ -246,11 +252,7 @@ def test_a_gain_in_one_channel_counts_though_the_other_channel_misses_far_more(
     rng = np.random.default_rng(7)
 
     def outputs(u_scale: float, f_scale: float) -> list[Outputs]:
-        return [
-            Outputs(tr.u_m + u_scale * rng.normal(0.0, tr.noise_u_m, tr.samples),
-                    tr.force_n + f_scale * rng.normal(0.0, tr.noise_force_n, tr.samples))
-            for tr in traces
-        ]  # fmt: skip
+        return _recorded_plus_noise(traces, rng, u_scale, f_scale)
 
     named = outputs(7.0, 2.0)
     evidence = judge(
