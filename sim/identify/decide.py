@@ -210,11 +210,11 @@ def judge(
     candidates at once, so flipping the signs of whole blocks — the same flip for every
     candidate — draws from the family's null; a candidate's family p-value is the share of
     flips whose *largest* statistic reaches its own (Westfall and Young's maxT, step-down:
-    ``family_p_values``). The chance that any candidate passes by luck stays at most ``ALPHA``, as with
-    Bonferroni, but the candidates' gains are strongly correlated — every refit also
-    moves the baseline's parameters, and the blocks where the baseline misses are the
-    same for all — so the family counts as fewer than m independent tests, and a real
-    effect needs less luck to show (Bonferroni's p × 9 lost a light stick-slip at
+    ``family_p_values``). The chance that any candidate passes by luck stays at most
+    ``ALPHA``, as with Bonferroni, but the candidates' gains are strongly correlated — every
+    refit also moves the baseline's parameters, and the blocks where the baseline misses
+    are the same for all — so the family counts as fewer than m independent tests, and a
+    real effect needs less luck to show (Bonferroni's p × 9 lost a light stick-slip at
     p = 0.0086).
 
     The family also holds each candidate judged in u alone and in F alone (the same
