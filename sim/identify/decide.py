@@ -227,12 +227,9 @@ def judge(
         return {}
     x_before = heldout_excess(traces, before)
     # Rows: each candidate pooled, then in each channel alone; one family of them all.
-    rows = [[(), *((c,) for c in CHANNELS)] for _ in names]
-    gains = np.stack([
-        block_gains(traces, before, candidates[n], which or CHANNELS)
-        for n, kinds in zip(names, rows, strict=True) for which in kinds
-    ])  # fmt: skip
-    p = family_p_values(gains, flips).reshape(len(names), 1 + len(CHANNELS))
+    views = [CHANNELS, *((c,) for c in CHANNELS)]
+    gains = np.stack([block_gains(traces, before, candidates[n], v) for n in names for v in views])
+    p = family_p_values(gains, flips).reshape(len(names), len(views))
     out = {}
     for k, name in enumerate(names):
         channels = tuple(
@@ -243,7 +240,7 @@ def judge(
         out[name] = Evidence(
             x_before=x_before,
             x_after=heldout_excess(traces, candidates[name]),
-            p_value=p_value_of_gains(gains[k * (1 + len(CHANNELS))]),
+            p_value=p_value_of_gains(gains[k * len(views)]),
             blocks=int(gains.shape[1]),
             p_family=float(p[k, 0]),
             channels=channels,
