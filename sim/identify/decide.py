@@ -230,11 +230,12 @@ def judge(
     views = [CHANNELS, *((c,) for c in CHANNELS)]
     gains = np.stack([block_gains(traces, before, candidates[n], v) for n in names for v in views])
     p = family_p_values(gains, flips).reshape(len(names), len(views))
+    x_channel = {c: heldout_excess(traces, before, (c,)) for c in CHANNELS}
     out = {}
     for k, name in enumerate(names):
         channels = tuple(
-            ChannelEvidence(c, heldout_excess(traces, before, (c,)),
-                            heldout_excess(traces, candidates[name], (c,)), float(p[k, 1 + j]))
+            ChannelEvidence(c, x_channel[c], heldout_excess(traces, candidates[name], (c,)),
+                            float(p[k, 1 + j]))
             for j, c in enumerate(CHANNELS)
         )  # fmt: skip
         out[name] = Evidence(
