@@ -16,18 +16,21 @@ from sim.config import StandConfig
 from sim.effects import EffectSpec
 from sim.effects.realism import MeasurementNoise, NoiseSpec
 from sim.identify import diagnose, make_trace
-from sim.identify.fitting import Candidate
-from sim.identify.heldout import Outputs, channel_gap
+from sim.identify.fitting import Candidate, simulate_values
+from sim.identify.heldout import BLOCK_S, Outputs, channel_gap
 from sim.identify.intervals import (
     ParameterIntervals,
     combined_error,
+    estimator_spread,
     gap_intervals,
     parameter_intervals,
     sandwich_covariance,
 )
 from sim.identify.per_recording import RecordingFit, consistency, drive_of, widened_baseline
+from sim.identify.replicates import reading_step, residual_replicates, smooth_weights
 from sim.identify.traces import Trace
 from sim.model import Model
+from sim.params import StandParams
 from sim.situations import SITUATIONS
 
 HEAVY = 8.131
@@ -58,13 +61,20 @@ def test_the_sandwich_covers_a_slope_under_errors_correlated_within_blocks() -> 
     assert naive_hits / trials < 0.6  # the correlation is real: ignoring it misleads
 
 
+def _heavy_none(
+    stand: StandConfig, seed: int, first: int
+) -> tuple[list[Trace], dict[str, float], StandParams]:
+    """Heavy `none`, moderate recordings from ``first`` on: traces, truth, nominal."""
+    recordings = recording_set("moderate", stand)[first:]
+    spec = CaseSpec("none", HEAVY, 0, seed)
+    traces, _, truth = make_campaign(stand, "none", HEAVY, spec.rng(), recordings)
+    return traces, truth, stand.stand_params("final", HEAVY)
+
+
 def test_baseline_intervals_hold_the_drawn_stand_and_widen_with_the_noise(
     stand: StandConfig,
 ) -> None:
-    recordings = recording_set("moderate", stand)[2:]
-    spec = CaseSpec("none", HEAVY, 0, 3)
-    traces, _, truth = make_campaign(stand, "none", HEAVY, spec.rng(), recordings)
-    nominal = stand.stand_params("final", HEAVY)
+    traces, truth, nominal = _heavy_none(stand, 3, 2)
     quiet = parameter_intervals(Candidate.build(), truth, traces, nominal)
     for name in ("stiffness_scale", "damping_scale", "friction_scale"):
         lo, hi = quiet.intervals[name]
@@ -272,3 +282,72 @@ def test_a_spread_from_few_replicates_carries_their_degrees_of_freedom() -> None
         hits_z += abs(miss) <= 1.96 * se
     assert hits_t / trials >= 0.94
     assert hits_z / trials < hits_t / trials - 0.02
+
+
+def _louder_after_rest(traces: list[Trace], times: float, rng: np.random.Generator) -> list[Trace]:
+    """The recordings with errors ``times`` their rest noise from the first cycle on.
+
+    The initial rest is untouched, so each trace's rest noise (what white replicates would
+    draw) stays what it was.
+    """
+    out = []
+    for tr in traces:
+        after = tr.cycle >= 0
+        u = tr.u_m + np.where(after, rng.normal(0.0, times * tr.noise_u_m, tr.samples), 0.0)
+        f = tr.force_n + np.where(after, rng.normal(0.0, times * tr.noise_force_n, tr.samples), 0.0)
+        t = np.arange(tr.samples) / tr.rate_hz
+        out.append(make_trace(tr.name, t, tr.x_m, u, f, tr.mass_kg))
+    return out
+
+
+def test_residual_replicates_reweight_the_fits_own_errors_smoothly(stand: StandConfig) -> None:
+    traces, truth, nominal = _heavy_none(stand, 5, 3)
+    candidate = Candidate.build()
+    (tr,) = traces
+    u_fit, f_fit = (a[0] for a in simulate_values(candidate, [truth], tr, nominal))
+    ((drawn,),), ((again,),) = (
+        residual_replicates(candidate, truth, traces, nominal, np.random.default_rng(s), 1)
+        for s in (0, 1)
+    )
+    # The same weight on both channels: the fit plus the residuals times it.
+    weight = smooth_weights(np.random.default_rng(0), tr.samples, BLOCK_S * tr.rate_hz)
+    ok = tr.present
+    for got, rec, fitted, step in (
+        (drawn.u_m, tr.u_m, u_fit, reading_step(tr.u_m)),
+        (drawn.force_n, tr.force_n, f_fit, reading_step(tr.force_n)),
+    ):
+        want = fitted + weight * (rec - fitted)
+        np.testing.assert_allclose(got[ok], want[ok], atol=step / 2 + 1e-12)
+    assert not np.array_equal(drawn.force_n[ok], again.force_n[ok])
+    assert np.array_equal(np.isnan(drawn.force_n), ~ok)  # a lost sample stays lost
+
+
+def test_the_bootstrap_weights_have_unit_variance_and_no_jumps() -> None:
+    span = 500.0
+    w = smooth_weights(np.random.default_rng(4), 400_000, span)
+    assert w.size == 400_000
+    assert abs(w.mean()) < 0.05 and w.var() == pytest.approx(1.0, abs=0.05)
+
+    def corr(lag: int) -> float:
+        return float(np.corrcoef(w[:-lag], w[lag:])[0, 1])
+
+    assert corr(int(span / 4)) > 0.7  # one stretch moves together
+    assert abs(corr(int(span))) < 0.1  # a span apart, nearly independent
+    # No step between neighbouring samples anywhere near a sign flip's 2.
+    assert np.abs(np.diff(w)).max() < 0.05
+
+
+def test_the_bootstrap_spread_follows_the_errors_in_motion_not_the_rest_noise(
+    stand: StandConfig,
+) -> None:
+    # Errors four times the rest noise while the drive moves (a restart from a
+    # noisy state, a drive read with noise): the estimator spreads about four times as
+    # far. Replicates with white noise at the rest level would not see it.
+    traces, truth, nominal = _heavy_none(stand, 6, 2)
+    loud = _louder_after_rest(traces, 4.0, np.random.default_rng(3))
+    assert [t.noise_force_n for t in loud] == pytest.approx([t.noise_force_n for t in traces])
+    candidate = Candidate.build()
+    quiet_shifts, _ = estimator_spread(candidate, truth, traces, nominal, replicates=8)
+    loud_shifts, _ = estimator_spread(candidate, truth, loud, nominal, replicates=8)
+    ratio = np.std(loud_shifts["stiffness_scale"]) / np.std(quiet_shifts["stiffness_scale"])
+    assert ratio > 2.0
