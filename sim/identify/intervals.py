@@ -15,16 +15,15 @@ The sandwich sees the residuals' spread, not the estimator's bias: restarts from
 measured states pull the damping by several times its standard error. A bootstrap
 (``estimator_spread``: the fit repeated on ``BIAS_REPLICATES`` recordings of the fitted
 model carrying the fit's own residuals times a smooth random weight: a dependent wild
-bootstrap) measures both. Its
-replicates carry the errors the fit left, not white noise at the rest level: the fit's
-residuals are 1.5 times the rest noise on the quick recordings and 2.7 times on the
-bursts (medians over 60 same-form campaigns; each restart starts from a measured
-state, a drive read with noise moves a whole swing), and with white noise only 78 %
-of the same-form intervals held the truth. The interval is centred on the
-bias-corrected value, as wide as the larger spread (plus the bias estimate's own
-uncertainty), and holds the fitted value. Six replicates know their spread only to a
-quarter or so: its Student t has the combined error's Welch–Satterthwaite degrees of
-freedom (``combined_error``), not the blocks'.
+bootstrap) measures both. Its replicates carry the errors the fit left, not white noise
+at the rest level: the fit's residuals are 1.5 times the rest noise on the quick
+recordings and 2.7 times on the bursts (medians over 60 same-form campaigns; each
+restart starts from a measured state, a drive read with noise moves a whole swing),
+and with white noise only 78 % of the same-form intervals held the truth (85 % now).
+The interval is centred on the bias-corrected value, as wide as the larger spread (plus
+the bias estimate's own uncertainty), and holds the fitted value. Six replicates know
+their spread only to a quarter or so: its Student t has the combined error's
+Welch–Satterthwaite degrees of freedom (``combined_error``), not the blocks'.
 
 Intervals are built in the optimiser's coordinates (log for the scales, so they are
 asymmetric in natural units), cut at the physical range and marked where they reach

@@ -78,9 +78,9 @@ def residual_replicates(
     and their correlation within a stretch and between the channels, none of which the
     rest noise knows. The weights change smoothly: signs flipped per block put a jump of
     twice the residual at each block's edge, and a restart's velocity read across it
-    (``shooting``) is off (on the dial gauge and gauge low-pass campaigns of seeds 6–8,
-    8 of 54 intervals missed the truth that way, 5 with smooth weights). Read in the
-    recording's own counts as ``replicate_traces`` does.
+    (``shooting``) is off: on the dial gauge and gauge low-pass campaigns of seeds 6–8,
+    8 of 54 intervals missed the truth with sign flips, 5 with smooth weights. Read in
+    the recording's own counts as ``replicate_traces`` does.
     """
     # As the fit sees it: each segment restarted from the recording's measured state
     # (open loop, a light weight's quick swings drift apart by millimetres).
