@@ -198,7 +198,6 @@ def parameter_intervals(
     for k, p in enumerate(free_params):
         se = float(se_free[k])
         zk = p.clipped(values[p.name])
-        centre = zk
         shift = shifts.get(p.name)
         t_k = t
         if shift is not None and shift.size > 1:
@@ -212,8 +211,8 @@ def parameter_intervals(
             se, dof = combined_error(se, max(clusters - 1, 1), spread, shift.size)
             t_k = float(stats.t.ppf(0.5 + level / 2, dof))
         lo, hi = p.bounds()
-        z_lo = max(min(centre - t_k * se, zk), lo)
-        z_hi = min(max(centre + t_k * se, zk), hi)
+        z_lo = max(zk - t_k * se, lo)
+        z_hi = min(zk + t_k * se, hi)
         out.internal_se[p.name] = se
         out.intervals[p.name] = (p.to_natural(z_lo), p.to_natural(z_hi))
         edge = 2e-3 * (hi - lo)
