@@ -209,20 +209,57 @@ def per_recording_figure(result: Diagnosis) -> Figure | None:
             err = [[max(below, 0.0)], [max(above, 0.0)]]
             ax.errorbar([x], [value], yerr=err, fmt="o", capsize=4,
                         color=_PALETTE[k % len(_PALETTE)], label=rec)  # fmt: skip
-        ax.set_title(_consistency_title(panel, test), fontsize=8, loc="left")
+        title = _consistency_title(panel, test)
+        law = result.dynamic_stiffness.get(
+            "final" if where == "params" and result.effects else "baseline_alone"
+        )
+        curve = name == "stiffness_scale" and by_rate and bool(law)
+        if curve and law:
+            _storage_curve(ax, law)
+            title += "\n" + _law_words(law)
+        ax.set_title(title, fontsize=8, loc="left")
         ax.grid(alpha=0.3)
         ax.tick_params(labelsize=8)
         if by_rate:
-            ax.set_xlabel("drive rate [Hz]", fontsize=8)
+            label = "drive rate; line: strain rate [Hz]" if curve else "drive rate [Hz]"
+            ax.set_xlabel(label, fontsize=8)
         else:
             ax.set_xticks(xs, [f"#{i + 1}" for i in xs])
             ax.set_xlabel("recording (no drive rate stored)", fontsize=8)
     for ax in list(axes.flat)[len(series) :]:
         ax.set_axis_off()
-    handles, labels = axes[0, 0].get_legend_handles_labels()
-    fig.legend(handles, labels, loc="outside upper center", ncol=min(len(labels), 4),
-               fontsize=8)  # fmt: skip
+    legend: dict[str, Any] = {}
+    for ax in axes.flat:  # each label once: the recordings, and the law's curves
+        for handle, label in zip(*ax.get_legend_handles_labels(), strict=True):
+            legend.setdefault(label, handle)
+    fig.legend(list(legend.values()), list(legend), loc="outside upper center",
+               ncol=min(len(legend), 4), fontsize=8)  # fmt: skip
     return cast("Figure", fig)
+
+
+def _storage_curve(ax: Any, rate: dict[str, Any] | None) -> None:
+    """The fibre's storage stiffness against its strain rate, with its 95 % band."""
+    if not rate or not rate.get("frequencies_hz"):
+        return
+    f = [_number(v) for v in rate["frequencies_hz"]]
+    low, high = zip(*rate["intervals"], strict=True)
+    colour = "#444444" if rate.get("rises_with_rate") else "#999999"
+    ax.fill_between(f, low, high, color=colour, alpha=0.15, linewidth=0)
+    ax.plot(f, rate["stiffness_scale"], color=colour, linewidth=1.2,
+            label="fibre's law: stiffness at each strain rate [Hz]")  # fmt: skip
+    ax.plot(f, rate["model_stiffness_scale"], color=colour, linewidth=0.8, linestyle=":",
+            label="the model's own, read the same way")  # fmt: skip
+    ax.set_xscale("log")
+
+
+def _law_words(law: dict[str, Any]) -> str:
+    """One title line: what the fibre's law says of the stiffness against the strain rate."""
+    share = law.get("explained_share")
+    if share is not None:
+        return f"law: the model has {share:.0%} of its rise"
+    if law.get("rises_with_rate"):
+        return f"law: rises with strain rate (p {_number(law.get('p_rise')):.2g})"
+    return "law: no rise beyond the model's"
 
 
 def _consistency_title(name: str, test: dict[str, Any] | None) -> str:

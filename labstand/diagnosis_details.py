@@ -109,6 +109,20 @@ def recording_section(result: Diagnosis, plotted: bool) -> str:
         if agree
         else f"<p>Agreement across recordings: {NOT_COMPUTED}.</p>"
     )
+    rates = "".join(
+        f"<li>{html.escape(label)}: {html.escape(str(r['trend']))}"
+        f"{html.escape(': ' + r['points_to']) if r.get('points_to') else ''}</li>"
+        for key, label in (("baseline_alone", "baseline alone"), ("final", "final model"))
+        if (r := result.dynamic_stiffness.get(key))
+    )
+    dynamic = (
+        "<p>The fibre's stiffness at each rate it is strained at, read off its law in the "
+        "recordings (F = k·e + c·ė and relaxation branches of 10–300 ms, fitted to the "
+        "training cycles, judged on the held-out ones against the model's own reading; the "
+        f"line in the stiffness panel):</p><ul>{rates}</ul>"
+        if rates
+        else ""
+    )
     plot = (
         '<img src="per_recording.png" alt="parameters per recording against the drive rate">'
         if plotted
@@ -121,6 +135,7 @@ recordings. Where effects are named, the baseline alone is fitted per recording 
 stiffness, damping and friction a hand-tuned model would need for each test, and whether
 the named effects explain why they differ.</p>
 {plot}
+{dynamic}
 <table><tr><th>recording</th><th>drive rate [Hz]</th><th>stroke [mm]</th>
 <th>mass [kg]</th>{head}</tr>{"".join(rows)}</table>
 {consistency}"""

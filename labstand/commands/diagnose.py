@@ -199,6 +199,12 @@ def _print_summary(result: Diagnosis, report: Path | None) -> None:
         if test.get("trend"):
             pointer = f": {test['points_to']}" if test.get("points_to") else ""
             print(f"Per recording{which}: {test['trend']}{pointer}")
+    for key, which in (("baseline_alone", " (baseline alone)" if result.effects else ""),
+                       ("final", "")):  # fmt: skip
+        rate = result.dynamic_stiffness.get(key)
+        if rate:
+            pointer = f": {rate['points_to']}" if rate.get("points_to") else ""
+            print(f"Fibre law{which}: {rate['trend']}{pointer}")
     print("Held-out gap        before            after")
     for ch in ("u", "F"):
         b, a = result.gap_before[ch], result.gap_after[ch]

@@ -63,25 +63,32 @@ def coverage_summary(cases: Sequence[Case]) -> dict[str, dict[str, float]]:
 
 #: The effect whose fingerprint the per-recording fits are checked for (issue 28).
 BRANCH = "fibre_viscoelastic"
+#: A ``Case.trends`` key: the baseline alone's fibre law stiffer at quicker strain rates.
+DYNAMIC = "dynamic_stiffness"
 
 
 def trend_summary(cases: Sequence[Case]) -> dict[str, dict[str, float]]:
-    """Per truth: how often the baseline alone fitted per recording pointed to a branch.
+    """Per truth: how often the baseline alone's stiffness was found to rise with the rate.
 
-    ``stiffness_with_rate``: its stiffness was flagged moving with the drive rate;
-    ``points_to_branch``: any of its parameters moved in a way that points to a
-    relaxation branch (a stiffness rising or a damping falling with the rate, or with
-    the stroke), whichever parameter the recordings let carry it.
+    ``stiffness_with_rate``: fitted per recording, its stiffness was flagged moving with
+    the drive rate; ``stiffness_with_strain_rate``: the fibre's law read off the
+    recordings is stiffer the quicker the fibre is strained (``dynamic_stiffness``);
+    ``flagged``: either; ``points_to_branch``: either, or any per-recording parameter
+    moved in a way that points to a relaxation branch (a stiffness rising or a damping
+    falling with the rate, or with the stroke).
     """
-    by_truth: dict[str, list[tuple[bool, bool]]] = {}
+    by_truth: dict[str, list[tuple[bool, bool, bool]]] = {}
     for c in cases:
         with_rate = "drive_rate_hz" in c.trends.get("stiffness_scale", "").split("+")
+        with_strain_rate = DYNAMIC in c.trends
         branch = any(BRANCH in text for text in c.points_to.values())
-        by_truth.setdefault(c.truth, []).append((with_rate, branch))
+        by_truth.setdefault(c.truth, []).append((with_rate, with_strain_rate, branch))
     return {
         t: {
-            "stiffness_with_rate": sum(a for a, _ in v) / len(v),
-            "points_to_branch": sum(b for _, b in v) / len(v),
+            "stiffness_with_rate": sum(a for a, _, _ in v) / len(v),
+            "stiffness_with_strain_rate": sum(b for _, b, _ in v) / len(v),
+            "flagged": sum(a or b for a, b, _ in v) / len(v),
+            "points_to_branch": sum(p for _, _, p in v) / len(v),
             "campaigns": len(v),
         }
         for t, v in by_truth.items()
@@ -99,6 +106,10 @@ def baseline_trends(d: Diagnosis) -> tuple[dict[str, str], dict[str, str]]:
         if v["moves_with"]
     }
     pointers = {k: v["points_to"] for k, v in d.baseline_consistency.items() if v["points_to"]}
+    dynamic = d.dynamic_stiffness.get("baseline_alone") or {}
+    if dynamic.get("rises_with_rate"):
+        trends[DYNAMIC] = "strain_rate_hz"
+        pointers[DYNAMIC] = dynamic["points_to"]
     return trends, pointers
 
 

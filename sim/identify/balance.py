@@ -47,7 +47,7 @@ from sim.params import StandParams
 FloatArray = NDArray[np.float64]
 BoolArray = NDArray[np.bool_]
 
-__all__ = ["BALANCE_VARIANTS", "BalanceFit", "fit_balances"]
+__all__ = ["BALANCE_VARIANTS", "BalanceFit", "FibreLaw", "fibre_law", "fit_balances"]
 
 #: The recorded channels are low-passed (zero phase) here before they are
 #: differentiated: the weight's acceleration from a 5 µm dial gauge is noise above it.
@@ -152,6 +152,38 @@ def _equations(
 def _near(marks: BoolArray, reach: int) -> BoolArray:
     """Samples within ``reach`` of a marked one."""
     return np.convolve(marks, np.ones(2 * reach + 1), mode="same").astype(bool)
+
+
+@dataclass(frozen=True)
+class FibreLaw:
+    """The fibre's law's parts on one trace (low-passed, SI) and where it can be read."""
+
+    e: FloatArray  # elongation, T₀/k + x − n·u
+    e_rate: FloatArray
+    force: FloatArray
+    usable: BoolArray  # taut, measured, inside the cycles, away from a segment's restart
+
+
+def fibre_law(
+    tr: Trace, nominal: StandParams, values: dict[str, float], model: Outputs | None = None
+) -> FibreLaw:
+    """The fibre's law read off the recording (or, with ``model``, off the model's outputs).
+
+    The same low-pass, spike removal and masks as the balances: the recorded force's
+    spikes and lost samples are bridged and their neighbourhood dropped in both, and so
+    is a segment restart's (the model's runs join there with a step).
+    """
+    spikes = _spikes(tr.force_n, tr.noise_force_n)
+    if model is None:
+        q = _equations(tr, tr.u_m, np.where(spikes, np.nan, tr.force_n), nominal, values)
+    else:
+        q = _equations(tr, model.u_m, model.force_n, nominal, values)
+    reach = int(tr.rate_hz / LOWPASS_HZ)
+    joins = np.zeros(tr.samples, dtype=bool)
+    joins[tr.segments.body[1:]] = True
+    present = ~_near(~tr.present | spikes, reach) & ~_near(joins, 3 * reach)
+    taut = (q.force > 0.2 * np.median(q.force)) & (q.e > 0)
+    return FibreLaw(q.e, q.e_rate, q.force, present & taut & (tr.cycle >= 0))
 
 
 def _balances(

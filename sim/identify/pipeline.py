@@ -17,7 +17,8 @@ The gap is measured on held-out cycles, in noise units. The stages, in order:
    candidates are refitted with them and judged against them the same way, up to
    ``MAX_EFFECTS``, each also against the richer forms of those named.
 6. **How sure** (``how_sure``): intervals of the final model's parameters and the gap
-   (``intervals``), and every recording fitted alone (``per_recording``).
+   (``intervals``), every recording fitted alone (``per_recording``), and the fibre's
+   stiffness against the rate it is strained at (``dynamic_stiffness``).
 7. **What remains** (``_what_remains``): a systematic remainder or none, and what it is
    like (``remainder``); the verdict joins it with the effects named.
 """
@@ -33,6 +34,7 @@ from typing import Any
 
 from sim.effects import EFFECTS
 from sim.identify.decide import Evidence, judge
+from sim.identify.dynamic_stiffness import rate_dependence
 from sim.identify.fitting import Candidate, FitResult, fit
 from sim.identify.heldout import (
     Outputs,
@@ -367,6 +369,12 @@ def how_sure(
         final.candidate, final.values, base_values, traces, nominal
     )
     run.simulations += sure.simulations + sims
+    # The fibre's stiffness against its strain rate, off the law in the recordings.
+    rate = {"baseline_alone": rate_dependence(traces, nominal, base_values, before)}
+    if accepted:
+        rate["final"] = rate_dependence(
+            traces, nominal, final.values, after, rate["baseline_alone"]
+        )
     return {
         "baseline_intervals": {k: v for k, v in sure.intervals.items() if k in base_values},
         "baseline_reaches_bound": [k for k in sure.reaches_bound if k in base_values],
@@ -376,6 +384,7 @@ def how_sure(
         "per_recording": table,
         "consistency": agree,
         "baseline_consistency": alone,
+        "dynamic_stiffness": {k: v.to_dict() for k, v in rate.items() if v is not None},
     }
 
 

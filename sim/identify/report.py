@@ -136,6 +136,9 @@ class Diagnosis:
     #: The same for the baseline alone fitted per recording (where effects are named;
     #: else the same as ``consistency``): what the named effects took out of the trends.
     baseline_consistency: dict[str, dict[str, Any]] = field(default_factory=dict)
+    #: The fibre's storage stiffness against its strain rate (``dynamic_stiffness``), for
+    #: ``baseline_alone`` and, where effects are named, the ``final`` model.
+    dynamic_stiffness: dict[str, dict[str, Any]] = field(default_factory=dict)
 
     @property
     def effect(self) -> str:
@@ -173,6 +176,7 @@ class Diagnosis:
             "per_recording": self.per_recording,
             "consistency": self.consistency,
             "baseline_consistency": self.baseline_consistency,
+            "dynamic_stiffness": self.dynamic_stiffness,
         }
 
 

@@ -25,12 +25,19 @@ def test_a_branch_is_counted_through_whichever_scale_carries_it() -> None:
         # the stiffness follows the stroke alone: neither count
         _case("fibre_viscoelastic", {"stiffness_scale": "stroke_m"},
               {"stiffness_scale": "a fibre that stiffens with strain (a nonlinear law)"}),
+        # the fibre's law stiffer at quicker strain rates, the per-recording fits flat
+        _case("fibre_viscoelastic", {"dynamic_stiffness": "strain_rate_hz"},
+              {"dynamic_stiffness": "a relaxation branch in the fibre (fibre_viscoelastic)"}),
         _case("none", {}, {}),
         _case("none", {"friction_scale": "drive_rate_hz"},
               {"friction_scale": "friction that grows with speed (a drag term)"}),
     ]  # fmt: skip
     got = trend_summary(cases)
     assert got["fibre_viscoelastic"] == {
-        "stiffness_with_rate": 1 / 3, "points_to_branch": 2 / 3, "campaigns": 3,
+        "stiffness_with_rate": 1 / 4, "stiffness_with_strain_rate": 1 / 4, "flagged": 2 / 4,
+        "points_to_branch": 3 / 4, "campaigns": 4,
     }  # fmt: skip
-    assert got["none"] == {"stiffness_with_rate": 0.0, "points_to_branch": 0.0, "campaigns": 2}
+    assert got["none"] == {
+        "stiffness_with_rate": 0.0, "stiffness_with_strain_rate": 0.0, "flagged": 0.0,
+        "points_to_branch": 0.0, "campaigns": 2,
+    }  # fmt: skip

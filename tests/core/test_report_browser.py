@@ -101,6 +101,13 @@ def _campaign(stand: StandConfig, tmp_path: Path) -> tuple[list[Trace], Diagnosi
             for k, (tr, (_, spec)) in enumerate(zip(traces, SMALL_CAMPAIGN, strict=True))
         },
         consistency={"stiffness_scale": {"p_value": 0.004, "trend": "grows with the rate"}},
+        dynamic_stiffness={"baseline_alone": {
+            "frequencies_hz": [0.5, 2.0, 12.0], "stiffness_scale": [1.0, 1.1, 1.3],
+            "intervals": [[0.98, 1.02], [1.08, 1.12], [1.27, 1.33]],
+            "model_stiffness_scale": [1.2, 1.2, 1.2], "rises_with_rate": True,
+            "trend": "rises with the strain rate: x1 at 0.5 Hz to x1.3 at 12 Hz",
+            "points_to": "a relaxation branch",
+        }},
     )  # fmt: skip
     sources = []
     for tr, (_, spec) in zip(traces, SMALL_CAMPAIGN, strict=True):
@@ -170,6 +177,12 @@ def test_the_first_screen_answers_which_how_sure_how_far_and_where_offline(
         b, a = result.gap_before[channel]["nrmse"], result.gap_after[channel]["nrmse"]
         assert f"{b:.4g}" in far and f"{a:.4g}" in far and f"{(a - b) / b:+.0%}" in far
     assert 'src="where.png"' in _section(page, "where")
+
+    # The fibre's law read against the strain rate: its trend beside the per-recording fits.
+    assert (
+        "baseline alone: rises with the strain rate: x1 at 0.5 Hz to x1.3 at 12 Hz: a "
+        "relaxation branch" in page
+    )
 
     # The ranking's clipped candidate says so; provenance names each file by its hash.
     assert "-3.5 (clipped in the chart)" in page

@@ -116,6 +116,33 @@ def test_the_baseline_alone_per_recording_follows_the_final_model() -> None:
         pyplot().close(fig)
 
 
+def test_the_fibres_stiffness_per_strain_rate_is_drawn_in_the_stiffness_panel() -> None:
+    result = _diagnosis([])
+    result.per_recording = {
+        name: {"params": {"stiffness_scale": k}, "drive_rate_hz": rate,
+               "intervals": {"stiffness_scale": (k - 0.01, k + 0.01)}}
+        for name, rate, k in (("quick", 2.0, 1.3), ("slow", 0.5, 1.1))
+    }  # fmt: skip
+    result.effects = []
+    curve = [1.0, 1.1, 1.4]
+    result.dynamic_stiffness = {"baseline_alone": {
+        "frequencies_hz": [0.4, 2.0, 10.0], "stiffness_scale": curve,
+        "intervals": [[0.95, 1.05], [1.05, 1.15], [1.3, 1.5]],
+        "model_stiffness_scale": [1.2, 1.2, 1.2], "rises_with_rate": True,
+    }}  # fmt: skip
+    fig = per_recording_figure(result)
+    assert fig is not None
+    try:
+        ax = fig.axes[0]
+        drawn = [list(line.get_ydata()) for line in ax.lines if len(line.get_xdata()) == 3]
+        assert curve in drawn and [1.2, 1.2, 1.2] in drawn
+        assert ax.get_xscale() == "log"
+        labels = [t.get_text() for t in fig.legends[0].get_texts()]
+        assert "quick" in labels and any("strain rate" in t for t in labels)
+    finally:
+        pyplot().close(fig)
+
+
 @pytest.mark.parametrize("name", ["x" * 80, "short"])
 def test_a_long_recording_name_is_shortened_in_titles(name: str) -> None:
     from labstand.diagnosis_plots import TITLE_NAME, short_name

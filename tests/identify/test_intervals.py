@@ -228,6 +228,10 @@ def test_the_papers_situations_with_a_relaxation_branch_need_their_own_stiffness
     pointers = [v["points_to"] or "" for v in d.baseline_consistency.values()]
     assert any("fibre_viscoelastic" in text for text in pointers)
     assert d.consistency["stiffness_scale"]["p_value"] >= 0.05
+    # Read off the fibre's law, the baseline alone's stiffness rises with the strain
+    # rate; the named branch's model rises as the recordings do.
+    assert d.dynamic_stiffness["baseline_alone"]["rises_with_rate"]
+    assert d.dynamic_stiffness["final"]["explained_share"] > 0.9
     # The branch's dissipation (k₂τ ≈ 600 N·s/m) is far beyond the catalogue's damping
     # range (×4 of 27.5 N·s/m): the baseline alone's per-recording fit has room for it,
     # so its damping is a measured value, not the range's end in every recording.
