@@ -370,11 +370,12 @@ def how_sure(
     )
     run.simulations += sure.simulations + sims
     # The fibre's stiffness against its strain rate, off the law in the recordings.
-    rate = {"baseline_alone": rate_dependence(traces, nominal, base_values, before)}
-    if accepted:
-        rate["final"] = rate_dependence(
-            traces, nominal, final.values, after, rate["baseline_alone"]
-        )
+    with run.timed("dynamic_stiffness"):
+        rate = {"baseline_alone": rate_dependence(traces, nominal, base_values, before)}
+        if accepted:
+            rate["final"] = rate_dependence(
+                traces, nominal, final.values, after, rate["baseline_alone"]
+            )
     return {
         "baseline_intervals": {k: v for k, v in sure.intervals.items() if k in base_values},
         "baseline_reaches_bound": [k for k in sure.reaches_bound if k in base_values],
