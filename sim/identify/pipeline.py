@@ -374,7 +374,7 @@ def how_sure(
         rate = {"baseline_alone": rate_dependence(traces, nominal, base_values, before)}
         if accepted:
             rate["final"] = rate_dependence(
-                traces, nominal, final.values, after, rate["baseline_alone"]
+                traces, nominal, final.values, after, rate["baseline_alone"], named=True
             )
     return {
         "baseline_intervals": {k: v for k, v in sure.intervals.items() if k in base_values},

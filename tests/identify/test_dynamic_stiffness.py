@@ -101,3 +101,31 @@ def test_a_maxwell_branch_reads_as_its_own_storage_stiffness(
     # and the rise's 95 % interval holds the branch's
     low, high = got.rise_interval
     assert low <= rise_theory <= high
+
+
+def _read_as(rise: float, p: float, alone_rise: float | None, named: bool) -> RateDependence:
+    return RateDependence(
+        frequencies_hz=[0.5, 12.0], stiffness_scale=[1.0, 1.0 + rise], intervals=[(1, 1)] * 2,
+        model_stiffness_scale=[1.0, 1.0], slowest_drive_hz=0.5, fastest_strain_hz=12.0,
+        rise=rise, rise_interval=(rise - 0.01, rise + 0.01), p_heldout=p, p_rise=p,
+        cycles_heldout=8, cycles_training=9, alone_rise=alone_rise, named=named,
+    )  # fmt: skip
+
+
+def test_a_rise_points_to_a_branch_unless_the_named_effects_have_it() -> None:
+    branch = "relaxation branch"
+    assert branch in (_read_as(0.3, 1e-4, None, named=False).points_to or "")
+    assert _read_as(0.3, 0.2, None, named=False).points_to is None  # not confirmed
+    assert _read_as(-0.3, 1e-4, None, named=False).points_to is None  # it falls
+    # Against a model with a branch named: a significant rest of 2 % of the rise is the
+    # named branch's own parameters, off by their interval; most of it is not.
+    kept = _read_as(0.01, 1e-4, 0.5, named=True)
+    assert kept.explained_share == pytest.approx(0.98) and kept.points_to is None
+    assert "98%" in kept.trend
+    missing = _read_as(0.4, 1e-4, 0.5, named=True)
+    assert missing.explained_share == pytest.approx(0.2)
+    assert "beyond the named effects" in (missing.points_to or "")
+    # The baseline alone showed none, the named effects' model leaves one.
+    new = _read_as(0.2, 1e-4, None, named=True)
+    assert "beyond the named effects" in (new.points_to or "")
+    assert "beyond the named effects' model" in new.trend
