@@ -27,6 +27,14 @@ started from, so the mean is a bias of the replicates' own. Six replicates know 
 spread only to a quarter or so: its Student t has the combined error's
 Welch–Satterthwaite degrees of freedom (``combined_error``), not the blocks'.
 
+A linearisation knows the cost only near the fit. Along each parameter's profile line
+(the others at their conditional optimum) the cost may rise less than the parabola
+further out: a valley flatter than it, or a second one just past a low ridge (a light
+pulley's inertia traded against its bearing torque, a branch's τ against the fibre's
+damping). Each end then moves out to the farthest point reached without the cost passing
+the parabola's rise at the end (``along_profiles``): the likelihood-ratio set at the
+level the interval already has, found on one batch of simulations per parameter.
+
 Intervals are built in the optimiser's coordinates (log for the scales, so they are
 asymmetric in natural units), cut at the physical range and marked where they reach
 it: there the data cannot say how far beyond the range the parameter would go. Counts
@@ -66,7 +74,9 @@ PARAMETER_METHOD = (
     "cluster-robust sandwich covariance over 0.25 s training blocks, Student t on "
     "blocks − 1 degrees of freedom, widened by a dependent wild bootstrap of the fit "
     "(its residuals times a random weight correlated over 0.25 s; Welch–Satterthwaite "
-    "degrees of freedom for its few replicates), centred on the fit"
+    "degrees of freedom for its few replicates), centred on the fit, each end carried "
+    "out along the parameter's profile line where the training cost stays below the "
+    "rise the linearisation gives at that end"
 )
 GAP_METHOD = "gap and closure: bootstrap over 0.25 s held-out blocks within each recording"
 BOOTSTRAP_ROUNDS = 1000
@@ -76,6 +86,8 @@ BIAS_REPLICATES = 6
 BIAS_EVALUATIONS = 15
 #: Rounds of the secant Jacobian (its steps the interval's half-widths) at most.
 SECANT_ROUNDS = 3
+#: How far along its profile line an interval's end may move, in its own half-widths.
+PROFILE_STEPS = (1.0, 1.5, 2.0, 3.0, 4.0, 6.0, 8.0)
 
 
 @dataclass
@@ -195,6 +207,7 @@ def parameter_intervals(
     out.simulations += objective.simulations
     out.widening = t / float(stats.norm.ppf(0.5 + level / 2))
     free_params = [p for p, f in zip(candidate.params, free, strict=True) if f]
+    ends: dict[str, tuple[float, float]] = {}
     for k, p in enumerate(free_params):
         se = float(se_free[k])
         zk = p.clipped(values[p.name])
@@ -211,14 +224,83 @@ def parameter_intervals(
             se, dof = combined_error(se, max(clusters - 1, 1), spread, shift.size)
             t_k = float(stats.t.ppf(0.5 + level / 2, dof))
         lo, hi = p.bounds()
-        z_lo = max(zk - t_k * se, lo)
-        z_hi = min(zk + t_k * se, hi)
         out.internal_se[p.name] = se
+        ends[p.name] = (max(zk - t_k * se, lo), min(zk + t_k * se, hi))
+    ends, sims = along_profiles(objective, candidate, z, free, ends)
+    out.simulations += sims
+    for p in free_params:
+        lo, hi = p.bounds()
+        z_lo, z_hi = ends[p.name]
         out.intervals[p.name] = (p.to_natural(z_lo), p.to_natural(z_hi))
         edge = 2e-3 * (hi - lo)
         if z_lo <= lo + edge or z_hi >= hi - edge:
             out.reaches_bound.append(p.name)
     return out
+
+
+def along_profiles(
+    objective: Objective,
+    candidate: Candidate,
+    z: FloatArray,
+    free: NDArray[np.bool_],
+    ends: dict[str, tuple[float, float]],
+) -> tuple[dict[str, tuple[float, float]], int]:
+    """Each interval's ends carried out along its profile where the cost stays as low.
+
+    Along the Gauss–Newton profile line of a parameter (the others at their conditional
+    optimum, d = Σe_k/Σ_kk, Σ = (JᵀJ)⁻¹ with J the secants over the interval), the local
+    quadratic says how far the training cost rises at the interval's end. Where the real
+    cost rises less than that further out (a valley flatter than a parabola: a pulley's
+    inertia traded against its bearing torque, a branch's τ against the fibre's
+    damping), the end moves out to the farthest of ``PROFILE_STEPS`` interval
+    half-widths reached without the cost passing that rise: the likelihood-ratio set at
+    the level the interval already has. Never narrows. ``ends``: per free parameter, the
+    interval in the optimiser's coordinates. Returns the new ends and the simulations.
+    """
+    params = [p for p, f in zip(candidate.params, free, strict=True) if f]
+    known = [
+        k for k, p in enumerate(params)
+        if p.name in ends and all(math.isfinite(v) for v in ends[p.name])
+    ]  # fmt: skip
+    if not known:
+        return ends, 0
+    lo_all = np.array([p.bounds()[0] for p in candidate.params])
+    hi_all = np.array([p.bounds()[1] for p in candidate.params])
+    steps = 1e-3 * (hi_all - lo_all)
+    half = np.array([0.5 * (ends[p.name][1] - ends[p.name][0]) if k in known else 0.0
+                     for k, p in enumerate(params)])  # fmt: skip
+    steps[free] = np.clip(half, steps[free], 0.5 * (hi_all - lo_all)[free])
+    sims = objective.simulations
+    jac = objective.jacobian(z, free, steps)
+    base = objective.residuals(z)
+    cost0 = float(base @ base)
+    sigma = np.linalg.pinv(jac.T @ jac)
+    out = dict(ends)
+    for k in known:
+        p = params[k]
+        if not sigma[k, k] > 0:
+            continue
+        direction = np.zeros(z.size)
+        direction[free] = sigma[:, k] / sigma[k, k]
+        zk = float(z[candidate.params.index(p)])
+        new = list(ends[p.name])
+        for side in (0, 1):
+            reach = ends[p.name][side] - zk
+            if reach == 0.0:
+                continue
+            rise = float(np.sum((jac @ (direction[free] * reach)) ** 2))
+            line = np.array([np.clip(z + m * reach * direction, lo_all, hi_all)
+                             for m in PROFILE_STEPS])  # fmt: skip
+            costs = np.sum(objective.residuals_batch(line) ** 2, axis=1) - cost0
+            farthest = 1.0
+            for m, cost in zip(PROFILE_STEPS, costs, strict=True):
+                if not cost <= rise:
+                    break
+                farthest = m
+            lo, hi = p.bounds()
+            new[side] = min(max(zk + farthest * reach, lo), hi)
+        out[p.name] = (min(new), max(new))
+    return out, objective.simulations - sims
 
 
 def estimator_spread(
