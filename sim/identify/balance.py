@@ -178,12 +178,23 @@ def fibre_law(
         q = _equations(tr, tr.u_m, np.where(spikes, np.nan, tr.force_n), nominal, values)
     else:
         q = _equations(tr, model.u_m, model.force_n, nominal, values)
+    return FibreLaw(q.e, q.e_rate, q.force, _measured(tr, spikes) & _taut(q) & (tr.cycle >= 0))
+
+
+def _measured(tr: Trace, spikes: BoolArray) -> BoolArray:
+    """Samples away from a lost sample, a spike or a segment's restart.
+
+    Lost samples and spikes were bridged before the low-pass: their neighbourhood is
+    interpolation, not measurement; a restart's step rings through the low-pass.
+    """
     reach = int(tr.rate_hz / LOWPASS_HZ)
     joins = np.zeros(tr.samples, dtype=bool)
     joins[tr.segments.body[1:]] = True
-    present = ~_near(~tr.present | spikes, reach) & ~_near(joins, 3 * reach)
-    taut = (q.force > 0.2 * np.median(q.force)) & (q.e > 0)
-    return FibreLaw(q.e, q.e_rate, q.force, present & taut & (tr.cycle >= 0))
+    return ~_near(~tr.present | spikes, reach) & ~_near(joins, 3 * reach)
+
+
+def _taut(q: _Equations) -> BoolArray:
+    return np.asarray((q.force > 0.2 * np.median(q.force)) & (q.e > 0))
 
 
 def _balances(
@@ -206,15 +217,8 @@ def _balances(
     rec = _equations(tr, tr.u_m, np.where(spikes, np.nan, tr.force_n), nominal, values)
     own = _equations(tr, model.u_m, model.force_n, nominal, values)
     g, f = rec.g - own.g, rec.f - own.f
-    # Lost samples and spikes were bridged before the low-pass: their neighbourhood is
-    # interpolation, not measurement; a restart's step rings through the low-pass.
-    reach = int(rate / LOWPASS_HZ)
-    joins = np.zeros(tr.samples, dtype=bool)
-    joins[tr.segments.body[1:]] = True
-    present = ~_near(~tr.present | spikes, reach) & ~_near(joins, 3 * reach)
-    taut = (rec.force > 0.2 * np.median(rec.force)) & (rec.e > 0)
-    taut_own = (own.force > 0.2 * np.median(own.force)) & (own.e > 0)
-    use_g = present & taut & taut_own
+    present = _measured(tr, spikes)
+    use_g = present & _taut(rec) & _taut(own)
     use_f = present & (np.abs(rec.v) > SLIDING_M_S) & (np.abs(own.v) > SLIDING_M_S)
     rest = slice(int(REST_S[0] * rate), max(int(REST_S[1] * rate), int(REST_S[0] * rate) + 10))
     noise_g = float(np.std(g[rest])) or 1.0
