@@ -34,9 +34,12 @@ def test_the_absorbed_share_is_the_branchs_complex_stiffness_at_the_ring_mode(
 def test_a_branch_the_baseline_absorbed_is_refitted_from_its_given_back_share() -> None:
     # A heavy campaign of the check (seed 1) with a Maxwell branch k₂ 3.0e4 N/m, τ 71 ms:
     # the baseline takes it into stiffness ×2.0 (its bound) and damping ×3.5. With the
-    # baseline held there, the grid's best is a weak, slow branch, and the refit from it
-    # stays slow (τ ≈ 0.5 s). Given back the branch's share, the grid's best costs less
-    # and the refit from it finds the branch (τ within a factor 2) at a lower cost.
+    # baseline held there, the grid's best is a weak, slow branch (4.9 kN/m, 0.32 s).
+    # Given back the branch's share, the grid's best is near the truth (22 kN/m, 37 ms),
+    # and the refit from it finds the branch (τ within a factor 2) at no more cost than
+    # the refit from the plain grid (0.00103 against 0.00114; before the branch restarted
+    # with the force the model gives it, the plain refit stuck at τ 0.5 s). The two grid
+    # points cost about the same, so ``refitting.refit`` refits from both.
     stand = default_config()
     spec = CaseSpec(EFFECT, 8.131, 0, 1)
     traces, _, truth = make_campaign(stand, EFFECT, 8.131, spec.rng())
@@ -64,11 +67,11 @@ def test_a_branch_the_baseline_absorbed_is_refitted_from_its_given_back_share() 
     given_back, given_back_cost = best_of(
         [{**base.values, **s} for s in branch_starts(traces, nominal, base.values)]
     )
-    assert given_back_cost < plain_cost
+    assert given_back_cost < 1.2 * plain_cost
     refits = [
         fit(cand, traces, nominal, baseline=start, single_start=True, max_nfev=15)
         for start in (plain, given_back)
     ]
-    assert refits[1].train_cost < 0.8 * refits[0].train_cost
+    assert refits[1].train_cost <= refits[0].train_cost
     tau = refits[1].values[f"{EFFECT}.relaxation_time_s"]
     assert 0.5 < tau / truth["relaxation_time_s"] < 2.0
