@@ -92,10 +92,7 @@ def _branch_history(
             if d1 > 0.0 and law1 > 0.0:
                 # Taut again from where δ turns positive, or (δ already positive) the law:
                 # the model locates the one its start shows (``integrator._step``).
-                if d0 <= 0.0:
-                    share = d0 / (d0 - d1)
-                else:
-                    share = max(0.0, law0 / (law0 - law1))
+                share = d0 / (d0 - d1) if d0 <= 0.0 else max(0.0, law0 / (law0 - law1))
                 y = _branch_part(y * np.exp(-share / tau_h), 1.0 - share, tau_h,
                                  change * (1.0 - share))  # fmt: skip
             else:
