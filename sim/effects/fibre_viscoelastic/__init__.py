@@ -5,10 +5,7 @@ Terms: ``sim.physics.kernel`` (why there: docs/architecture.md); equations: docs
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
-from numba import njit
 from numpy.typing import NDArray
 
 from sim.effects.info import EffectInfo, Measured, param
@@ -31,74 +28,16 @@ def branch_elongation(row: FloatArray, measured: Measured) -> FloatArray:
     of a ramp, the history came out h/2τ too large (0.8 % at τ = 30 ms); a switch
     placed at a sample instead of inside it left up to k₂·Δδ (2 N at 0.2 m/s).
     """
+    from sim.effects.fibre_viscoelastic.history import branch_history  # numba, when run
     from sim.physics import layout  # the registry's columns (it imports this module)
 
     n = row[layout.P_PROJ]
     delta = row[layout.P_PRELOAD] + measured.x_rel_m - n * measured.u_m
     drive_rate = np.diff(measured.x_rel_m, prepend=measured.x_rel_m[0]) * measured.rate_hz
-    return _branch_history(
+    return branch_history(
         delta, drive_rate, n * measured.v_m_s, measured.rate_hz * row[layout.R_VE_TAU],
         row[layout.P_STIFF], row[layout.P_DAMP], row[layout.R_VE_K],
     )  # fmt: skip
-
-
-@njit(cache=True)
-def _branch_part(y: float, share: float, tau_h: float, change: float) -> float:
-    """y after ``share`` of a step taut, δ changing linearly by ``change`` over it (exact)."""
-    if share <= 0.0:
-        return y
-    decay = math.exp(-share / tau_h)
-    return y * decay + (1.0 - decay) * tau_h * change / share
-
-
-@njit(cache=True)
-def _branch_history(
-    delta: FloatArray,
-    drive_rate: FloatArray,
-    weight_rate: FloatArray,
-    tau_h: float,
-    k: float,
-    c: float,
-    k2: float,
-) -> FloatArray:
-    """q/k₂ at every sample from rest; ``tau_h`` is τ in samples.
-
-    ``drive_rate[i]``: the drive's rate over the step that ends at sample i;
-    ``weight_rate``: n·v at every sample. One regime switch per step at most, located by
-    linear interpolation of δ and of the law.
-    """
-    out = np.zeros(delta.size)
-    y = 0.0
-    for i in range(1, delta.size):
-        d0, d1 = delta[i - 1], delta[i]
-        change = d1 - d0
-        law0 = k * d0 + c * (drive_rate[i] - weight_rate[i - 1]) + k2 * y
-        rate1 = c * (drive_rate[i] - weight_rate[i])
-        if d0 > 0.0 and law0 > 0.0:  # taut at the step's start
-            taut_y = _branch_part(y, 1.0, tau_h, change)
-            law1 = k * d1 + rate1 + k2 * taut_y
-            if d1 > 0.0 and law1 > 0.0:
-                y = taut_y
-            else:  # goes slack where δ or the law reaches zero first
-                share = 1.0
-                if d1 <= 0.0:
-                    share = min(share, d0 / (d0 - d1))
-                if law1 <= 0.0:
-                    share = min(share, law0 / (law0 - law1))
-                y = _branch_part(y, share, tau_h, change * share) * np.exp(-(1.0 - share) / tau_h)
-        else:
-            slack_y = y * np.exp(-1.0 / tau_h)
-            law1 = k * d1 + rate1 + k2 * slack_y
-            if d1 > 0.0 and law1 > 0.0:
-                # Taut again from where δ turns positive, or (δ already positive) the law:
-                # the model locates the one its start shows (``integrator._step``).
-                share = d0 / (d0 - d1) if d0 <= 0.0 else max(0.0, law0 / (law0 - law1))
-                y = _branch_part(y * np.exp(-share / tau_h), 1.0 - share, tau_h,
-                                 change * (1.0 - share))  # fmt: skip
-            else:
-                y = slack_y
-        out[i] = y
-    return out
 
 
 def _start_state(
