@@ -41,6 +41,7 @@ def branch_history(
     linear interpolation of δ and of the law.
     """
     out = np.zeros(delta.size)
+    decay = math.exp(-1.0 / tau_h)  # over one whole step
     y = 0.0
     for i in range(1, delta.size):
         d0, d1 = delta[i - 1], delta[i]
@@ -48,7 +49,7 @@ def branch_history(
         law0 = k * d0 + c * (drive_rate[i] - weight_rate[i - 1]) + k2 * y
         rate1 = c * (drive_rate[i] - weight_rate[i])
         if d0 > 0.0 and law0 > 0.0:  # taut at the step's start
-            taut_y = branch_part(y, 1.0, tau_h, change)
+            taut_y = y * decay + (1.0 - decay) * tau_h * change
             law1 = k * d1 + rate1 + k2 * taut_y
             if d1 > 0.0 and law1 > 0.0:
                 y = taut_y
@@ -58,16 +59,16 @@ def branch_history(
                     share = min(share, d0 / (d0 - d1))
                 if law1 <= 0.0:
                     share = min(share, law0 / (law0 - law1))
-                y = branch_part(y, share, tau_h, change * share) * np.exp(-(1.0 - share) / tau_h)
+                y = branch_part(y, share, tau_h, change * share) * math.exp(-(1.0 - share) / tau_h)
         else:
-            slack_y = y * np.exp(-1.0 / tau_h)
+            slack_y = y * decay
             law1 = k * d1 + rate1 + k2 * slack_y
             if d1 > 0.0 and law1 > 0.0:
                 # Taut again from where δ turns positive, or (δ already positive) the law:
                 # the model locates the one its start shows (``integrator._step``).
                 share = d0 / (d0 - d1) if d0 <= 0.0 else max(0.0, law0 / (law0 - law1))
-                y = branch_part(y * np.exp(-share / tau_h), 1.0 - share, tau_h,
-                                 change * (1.0 - share))  # fmt: skip
+                y = branch_part(y * math.exp(-share / tau_h), 1.0 - share, tau_h,
+                                change * (1.0 - share))  # fmt: skip
             else:
                 y = slack_y
         out[i] = y
