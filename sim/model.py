@@ -35,7 +35,8 @@ from numpy.typing import NDArray
 from sim.effects.registry import EFFECTS, EffectError, EffectSpec, check_unique
 from sim.errors import SimulationError
 from sim.params import StandParams
-from sim.physics import runs, starts
+from sim.physics import layout, runs, starts
+from sim.physics.refine import StartWindow, refined_starts
 from sim.physics.runs import DEFAULT_SUBSTEPS, check_input
 from sim.results import BatchResult, ModelRun, SimResult
 
@@ -51,6 +52,7 @@ __all__ = [
     "Restarts",
     "SimResult",
     "SimulationError",
+    "StartWindow",
     "Variant",
 ]
 
@@ -90,6 +92,10 @@ class Restarts:
         gauge's scale G = slope·n; every segment restarts from u/G, so a gauge's scale
         error stays in the u channel (the model's gauge effect then maps u to the
         reading) instead of becoming a wrong elongation, a wrong force.
+    window
+        The recorded channels after each start and their noise: each later segment's u
+        and v are refined by the model over that window (``sim.physics.refine``); None:
+        they start as estimated.
     """
 
     starts: IntArray
@@ -98,6 +104,7 @@ class Restarts:
     v_m_s: FloatArray
     force_n: FloatArray
     dial_slope: float = float("nan")
+    window: StartWindow | None = None
 
 
 class Model:
@@ -221,6 +228,14 @@ class Model:
             rows, x_rel, rate_hz, restarts.starts, restarts.u_m, restarts.v_m_s,
             restarts.force_n, restarts.dial_slope,
         )  # fmt: skip
+        if restarts.window is not None:
+            slope = restarts.dial_slope
+            known = np.isfinite(slope) and slope > 0
+            scale = slope * rows[:, layout.P_PROJ] if known else np.ones(rows.shape[0])
+            init = refined_starts(
+                x_rel, rate_hz, rows, self.stand.friction, restarts.starts, restarts.lengths,
+                init, seats, restarts.window, scale, self.substeps, serial,
+            )  # fmt: skip
         return runs.simulate_segments(
             x_rel, rate_hz, rows, self.stand.friction, restarts.starts, restarts.lengths, init,
             self.substeps, chained=self.chained, serial=serial, seats=seats,

@@ -44,9 +44,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.signal import savgol_filter
+from scipy.signal import savgol_coeffs, savgol_filter
 
-from sim.model import Restarts
+from sim.model import Restarts, StartWindow
 
 if TYPE_CHECKING:  # the trace holds its segments; only its type is needed here
     from sim.identify.traces import Trace
@@ -86,6 +86,9 @@ class Segments:
         du/dx at constant force on a calm taut fibre (``dial_slope``), NaN if unknown.
     seg_of, offset
         For every sample of the trace: its segment and index inside that segment's run.
+    window
+        The recorded channels over each later segment's warm-up, which refine its start
+        (``sim.model.StartWindow``); None: the starts stay as estimated.
     """
 
     starts: IntArray
@@ -97,6 +100,7 @@ class Segments:
     seg_of: IntArray
     offset: IntArray
     dial_slope: float = float("nan")
+    window: StartWindow | None = None
 
     @property
     def count(self) -> int:
@@ -116,7 +120,9 @@ class Segments:
         error of one open-loop run).
         """
         lengths = np.minimum(self.lengths + lookahead, self.seg_of.size - self.starts)
-        return Restarts(self.starts, lengths, self.u_m, self.v_m_s, self.force_n, self.dial_slope)
+        return Restarts(
+            self.starts, lengths, self.u_m, self.v_m_s, self.force_n, self.dial_slope, self.window
+        )
 
     def assemble(self, runs: FloatArray) -> FloatArray:
         """Segment runs (sets, segments, samples) → one series per set (sets, N)."""
@@ -140,8 +146,9 @@ class Segments:
         np.maximum.at(lengths, position, offset + 1 + lookahead)
         lengths = np.minimum(lengths, self.seg_of.size - self.starts[keep])
         restarts = Restarts(
-            self.starts[keep], lengths, self.u_m, self.v_m_s, self.force_n, self.dial_slope
-        )
+            self.starts[keep], lengths, self.u_m, self.v_m_s, self.force_n, self.dial_slope,
+            self.window,
+        )  # fmt: skip
         return restarts, position, offset
 
     def leading(self, samples: IntArray, lookahead: int = 0) -> tuple[Restarts, IntArray, IntArray]:
@@ -159,8 +166,9 @@ class Segments:
         tail = int(offset[position == last - 1].max()) + 1 + lookahead if samples.size else 1
         lengths[-1] = min(int(lengths[-1]), tail)
         restarts = Restarts(
-            self.starts[:last], lengths, self.u_m, self.v_m_s, self.force_n, self.dial_slope
-        )
+            self.starts[:last], lengths, self.u_m, self.v_m_s, self.force_n, self.dial_slope,
+            self.window,
+        )  # fmt: skip
         return restarts, position, offset
 
 
@@ -215,7 +223,31 @@ def segment_trace(
     slope = trace.dial_slope
     if not np.isfinite(slope):
         slope = dial_slope([trace])
-    return Segments(starts, lengths, body, u_s, v_s, f_s, seg_of, offset, slope)
+    window = start_window(trace, warm, half_width_s)
+    return Segments(starts, lengths, body, u_s, v_s, f_s, seg_of, offset, slope, window)
+
+
+def start_window(trace: Trace, samples: int, half_width_s: float) -> StartWindow:
+    """The recorded channels that refine each start over ``samples`` after it.
+
+    The prior spreads are the local cubic fit's own under the gauge noise (the norms of its
+    smoothing and differentiating weights).
+    """
+    half = max(2, round(half_width_s * trace.rate_hz))
+    window = 2 * half + 1
+    order = 3 if window > 4 else window - 1
+    level = savgol_coeffs(window, order, use="dot")
+    rate = savgol_coeffs(window, order, deriv=1, delta=1.0 / trace.rate_hz, use="dot")
+    return StartWindow(
+        samples,
+        _filled(trace.u_m),
+        _filled(trace.force_n),
+        trace.present,
+        trace.noise_u_m,
+        trace.noise_force_n,
+        trace.noise_u_m * float(np.linalg.norm(level)),
+        trace.noise_u_m * float(np.linalg.norm(rate)),
+    )
 
 
 def _smoothed(

@@ -8,12 +8,13 @@ which cycle each sample belongs to, and whether it is used for fitting or held o
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.signal import butter, sosfiltfilt
+from scipy.signal import butter, sosfiltfilt, welch
 
 from sim.grid import GridError, align_arrays
 from sim.identify.shooting import Segments, segment_trace
@@ -30,12 +31,19 @@ MOVING_SPEED_M_S = 1e-3
 MIN_DURATION_S = 1.0
 #: Less drive travel than this identifies nothing, m.
 MIN_STROKE_M = 1e-3
-#: The measured drive position is low-passed (zero phase) at this frequency, Hz, before
-#: it drives the model: the drive is a massive servo axis with nothing above a few tens of
-#: Hz, while encoder noise differentiated by the fibre damping (c·ẋ) would otherwise put
-#: broadband noise into the model's force, which candidates that smooth it (a gauge
-#: low-pass, a Maxwell branch) then "explain".
-DRIVE_FILTER_HZ = 150.0
+#: The measured drive position drives the model after a zero-phase low-pass whose
+#: cut-off is where the drive's own motion sinks below the encoder's noise (its
+#: spectrum's floor, read from the top of the band, where a massive servo axis moves
+#: nothing): encoder noise differentiated by the fibre damping (c·ẋ) would put broadband
+#: noise into the model's force that candidates which smooth it (a gauge low-pass, a
+#: Maxwell branch) then "explain", and a cut-off below the motion rounds every corner of
+#: it into a force misfit that a resonance then "explains". Where signal and noise reach
+#: the model's force through the same fibre, the cut that loses least is where their
+#: spectra cross (the brick-wall Wiener filter).
+#: Bands of the drive's spectrum compared with its noise floor (per octave, from 10 Hz).
+DRIVE_BANDS_PER_OCTAVE = 4
+#: The noise floor is the median spectral density over this share of the band (of Nyquist).
+DRIVE_FLOOR_BAND = (0.6, 0.95)
 
 
 class DiagnosisInputError(ValueError):
@@ -140,11 +148,36 @@ def _split(cycle: IntArray, n: int) -> BoolArray:
     return train
 
 
+def drive_cutoff_hz(x_m: FloatArray, rate_hz: float) -> float:
+    """Where the drive's motion sinks below its encoder noise, Hz (the Nyquist: nowhere).
+
+    The noise floor is the median Welch density at the top of the band; the cut-off is
+    the upper edge of the highest band (log-spaced from 10 Hz) whose mean density is
+    above twice the floor, i.e. where the motion's share still exceeds the noise's.
+    """
+    nyquist = rate_hz / 2
+    if x_m.size < 64:
+        return nyquist
+    ramp = np.linspace(x_m[0], x_m[-1], x_m.size)  # the net move leaks into every band
+    freq, density = welch(x_m - ramp, rate_hz, nperseg=min(1024, x_m.size), detrend=False)
+    lo, hi = DRIVE_FLOOR_BAND
+    floor = float(np.median(density[(freq >= lo * nyquist) & (freq <= hi * nyquist)]))
+    octaves = np.log2(nyquist / 10.0)
+    edges = np.geomspace(10.0, nyquist, max(2, int(np.ceil(octaves * DRIVE_BANDS_PER_OCTAVE))))
+    cutoff = float(edges[0])
+    for low, high in itertools.pairwise(edges):
+        band = (freq >= low) & (freq < high)
+        if band.any() and float(density[band].mean()) > 2.0 * floor:
+            cutoff = float(high)
+    return cutoff
+
+
 def _smooth_drive(x_m: FloatArray, rate_hz: float) -> FloatArray:
     nyquist = rate_hz / 2
-    if 0.8 * nyquist <= DRIVE_FILTER_HZ or x_m.size < 30:
+    cutoff = drive_cutoff_hz(x_m, rate_hz)
+    if 0.8 * nyquist <= cutoff or x_m.size < 30:
         return x_m
-    sos = butter(4, DRIVE_FILTER_HZ / nyquist, output="sos")
+    sos = butter(4, cutoff / nyquist, output="sos")
     # Pad with the end values so the filter starts and ends at rest.
     smoothed: FloatArray = sosfiltfilt(sos, x_m, padtype="constant")
     return smoothed
