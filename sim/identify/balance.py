@@ -311,6 +311,7 @@ class _BalanceLibrary:
                 add(f"tanh(v/{s:g} m/s)", "N", "weight", np.tanh(b.v / s))
             for s in VELOCITY_SCALES_M_S:  # a gauge's backlash: the reading lags the motion
                 add(f"tanh(v/{s:g} m/s)", "m", "u", np.tanh(b.v / s))
+            add(f"v/{vt}", "m", "u", b.v / self.v_top)  # … or its own dynamics do
         elif kind == "resonance":
             for hz in BALANCE_MODES_HZ:
                 for zeta in BALANCE_MODE_ZETAS:

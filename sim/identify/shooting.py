@@ -38,6 +38,7 @@ every start state comes from measurements, never from a fitted trajectory.
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
@@ -121,8 +122,13 @@ class Segments:
         """
         lengths = np.minimum(self.lengths + lookahead, self.seg_of.size - self.starts)
         return Restarts(
-            self.starts, lengths, self.u_m, self.v_m_s, self.force_n, self.dial_slope, self.window
-        )
+            self.starts, lengths, self.u_m, self.v_m_s, self.force_n, self.dial_slope,
+            self._window(lookahead),
+        )  # fmt: skip
+
+    def _window(self, lookahead: int) -> StartWindow | None:
+        """The start window, its runs going on ``lookahead`` samples (a channel read early)."""
+        return None if self.window is None else dataclasses.replace(self.window, ahead=lookahead)
 
     def assemble(self, runs: FloatArray) -> FloatArray:
         """Segment runs (sets, segments, samples) → one series per set (sets, N)."""
@@ -147,7 +153,7 @@ class Segments:
         lengths = np.minimum(lengths, self.seg_of.size - self.starts[keep])
         restarts = Restarts(
             self.starts[keep], lengths, self.u_m, self.v_m_s, self.force_n, self.dial_slope,
-            self.window,
+            self._window(lookahead),
         )  # fmt: skip
         return restarts, position, offset
 
@@ -167,7 +173,7 @@ class Segments:
         lengths[-1] = min(int(lengths[-1]), tail)
         restarts = Restarts(
             self.starts[:last], lengths, self.u_m, self.v_m_s, self.force_n, self.dial_slope,
-            self.window,
+            self._window(lookahead),
         )  # fmt: skip
         return restarts, position, offset
 
@@ -230,23 +236,29 @@ def segment_trace(
 def start_window(trace: Trace, samples: int, half_width_s: float) -> StartWindow:
     """The recorded channels that refine each start over ``samples`` after it.
 
-    The prior spreads are the local cubic fit's own under the gauge noise (the norms of its
-    smoothing and differentiating weights).
+    The prior spreads are the local cubic fit's own: its smoothing and differentiating
+    weights' norms times the larger of the gauge noise and the fit's residual spread
+    there (where the cubic cannot follow the motion, a ringing say, its estimate is
+    worth less than the noise alone says).
     """
     half = max(2, round(half_width_s * trace.rate_hz))
     window = 2 * half + 1
     order = 3 if window > 4 else window - 1
+    u = _filled(trace.u_m)
+    residual = u - savgol_filter(u, window, order, mode="interp")
+    local = np.convolve(residual**2, np.ones(window) / window, mode="same")
+    spread = np.maximum(trace.noise_u_m, np.sqrt(local * window / max(window - order - 1, 1)))
     level = savgol_coeffs(window, order, use="dot")
     rate = savgol_coeffs(window, order, deriv=1, delta=1.0 / trace.rate_hz, use="dot")
     return StartWindow(
         samples,
-        _filled(trace.u_m),
+        u,
         _filled(trace.force_n),
         trace.present,
         trace.noise_u_m,
         trace.noise_force_n,
-        trace.noise_u_m * float(np.linalg.norm(level)),
-        trace.noise_u_m * float(np.linalg.norm(rate)),
+        spread * float(np.linalg.norm(level)),
+        spread * float(np.linalg.norm(rate)),
     )
 
 

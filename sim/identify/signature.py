@@ -260,6 +260,7 @@ class _Library:
                 Term(kind, "weight", f"v·|v|/({v})²", "N"),
                 *(Term(kind, "weight", f"tanh(v/{s:g} m/s)", "N") for s in VELOCITY_SCALES_M_S),
                 *(Term(kind, "u", f"tanh(v/{s:g} m/s)", "m") for s in VELOCITY_SCALES_M_S),
+                Term(kind, "u", f"v/{v}", "m"),  # a reading that lags: the gauge's own dynamics
             ]
         if kind == "resonance":  # the tension through a damped mode, as a force or a reading
             return [
@@ -299,6 +300,7 @@ class _Library:
             rows += [v / self.v_top, v * np.abs(v) / self.v_top**2]
             rows += [np.tanh(v / s) for s in VELOCITY_SCALES_M_S]
             rows += [np.tanh(v / s) for s in VELOCITY_SCALES_M_S]
+            rows += [v / self.v_top]
         elif kind == "resonance":
             for hz in RESONANCE_HZ:
                 mode = _mode_response(out.force_n, hz, tr.rate_hz)

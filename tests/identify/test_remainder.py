@@ -220,8 +220,9 @@ def test_an_effect_outside_the_catalogue_is_unexplained_and_described_by_its_kin
 def test_a_single_effect_of_another_form_names_no_second_effect(stand: StandConfig) -> None:
     # The other stand's dial gauge (seed 1, light weight): gain 1.034 with a curvature
     # and 9 µm of backlash, which our gauge candidate lacks. A time skew soaked up the
-    # backlash as a second effect; a quadratic term of the library does as well, so the
-    # skew is no evidence of a second effect.
+    # backlash as a second effect; a quadratic term of the library did as well, so it
+    # was set aside. With the starts refined by both gauges over each warm-up (the
+    # backlash no longer moves them), the skew does not pass its own test.
     rng = CaseSpec("dial_gauge_calibration", LIGHT, 0, 1).rng()
     traces, _, _ = make_campaign(
         stand, "dial_gauge_calibration", LIGHT, rng, truth_stand="other",
@@ -229,4 +230,3 @@ def test_a_single_effect_of_another_form_names_no_second_effect(stand: StandConf
     )  # fmt: skip
     result = diagnose(traces, stand.stand_params("final", LIGHT), CANDIDATES)
     assert [e.effect for e in result.effects] == ["dial_gauge_calibration"]
-    assert "channel_time_skew" in result.displaced
