@@ -27,6 +27,9 @@ at most one segment and the fit compares the model's short-term dynamics with th
   skew), so the state is the true one the candidate implies. The model does that
   (``sim.model.Model.run_segments``), and sets the effects' own states: quasi-static
   values, and for the Maxwell branch its response to the measured elongation history.
+  Then the model refines u and v over the warm-up, from both gauges, the cubic fit as
+  prior (``sim.physics.refine``: the weight rings on a taut fibre, and the fit's
+  velocity error rang through every segment).
   Those the gauges cannot see at a start (string modes, LuGre bristle) carry over from
   the previous segment's run instead. The pulley seat follows the recorded slack
   episodes, at the start and inside every run (``kernel.measured_seats``).
@@ -38,7 +41,6 @@ every start state comes from measurements, never from a fitted trajectory.
 
 from __future__ import annotations
 
-import dataclasses
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
@@ -123,12 +125,8 @@ class Segments:
         lengths = np.minimum(self.lengths + lookahead, self.seg_of.size - self.starts)
         return Restarts(
             self.starts, lengths, self.u_m, self.v_m_s, self.force_n, self.dial_slope,
-            self._window(lookahead),
+            self.window,
         )  # fmt: skip
-
-    def _window(self, lookahead: int) -> StartWindow | None:
-        """The start window, its runs going on ``lookahead`` samples (a channel read early)."""
-        return None if self.window is None else dataclasses.replace(self.window, ahead=lookahead)
 
     def assemble(self, runs: FloatArray) -> FloatArray:
         """Segment runs (sets, segments, samples) → one series per set (sets, N)."""
@@ -153,7 +151,7 @@ class Segments:
         lengths = np.minimum(lengths, self.seg_of.size - self.starts[keep])
         restarts = Restarts(
             self.starts[keep], lengths, self.u_m, self.v_m_s, self.force_n, self.dial_slope,
-            self._window(lookahead),
+            self.window,
         )  # fmt: skip
         return restarts, position, offset
 
@@ -173,7 +171,7 @@ class Segments:
         lengths[-1] = min(int(lengths[-1]), tail)
         restarts = Restarts(
             self.starts[:last], lengths, self.u_m, self.v_m_s, self.force_n, self.dial_slope,
-            self._window(lookahead),
+            self.window,
         )  # fmt: skip
         return restarts, position, offset
 

@@ -19,7 +19,8 @@ noise unit, so a form one of them has and the candidate lacks (a dial gauge's ba
 a force gauge's drifting zero) moves the start only as far as the other allows; u's
 prior is widened (``U_PRIOR_WIDENING``) so that on a taut fibre the force has its say
 on u too. A channel recorded late has no prediction in its first samples (their true
-values lie before the start): those weigh nothing.
+values lie before the start): those weigh nothing; for one recorded early the window's
+runs go on past it.
 The window lies before the segment's scored body, so its predictions stay predictions:
 the start comes from measurements, never from a fitted trajectory. Runs there are not
 chained (the carried states start quasi-static).
@@ -70,8 +71,6 @@ class StartWindow:
         The gauges' noise, m and N rms (the residuals' units).
     spread_u_m, spread_v_m_s
         The starting estimate's spread at every sample (the prior), recorded units.
-    ahead
-        How far past the window its runs go on (a channel recorded early reads ahead).
     """
 
     samples: int
@@ -82,7 +81,6 @@ class StartWindow:
     noise_force_n: float
     spread_u_m: FloatArray
     spread_v_m_s: FloatArray
-    ahead: int = 0
 
     @property
     def usable(self) -> bool:
@@ -113,7 +111,10 @@ def refined_starts(
     if not window.usable or later.size == 0:
         return init
     span = np.minimum(window.samples, lengths[later]).astype(np.int64)
-    run = np.minimum(window.samples + window.ahead, lengths[later]).astype(np.int64)
+    # A channel recorded early reads past the window: its runs go on that far.
+    early = int(max(_late(rows, layout.R_CS_FORCE, rate_hz, -1.0).max(),
+                    _late(rows, layout.R_CS_DISP, rate_hz, -1.0).max()))  # fmt: skip
+    run = np.minimum(window.samples + early, x_rel_m.size - starts[later]).astype(np.int64)
     at = starts[later]
     prior_u = U_PRIOR_WIDENING * window.spread_u_m[at][None, :] / scale[:, None]  # model units
     prior_v = window.spread_v_m_s[at][None, :] / scale[:, None]
@@ -165,12 +166,14 @@ def _sensitivities(runs3: FloatArray, probe_u: FloatArray, probe_v: FloatArray) 
     return np.stack([by_u, by_v], axis=-1)
 
 
-def _late(rows: FloatArray, column: int, rate_hz: float) -> IntArray:
-    """Per row (sets, 1, 1): the samples a skewed channel is recorded late.
+def _late(rows: FloatArray, column: int, rate_hz: float, sign: float = 1.0) -> IntArray:
+    """Per row (sets, 1, 1): the samples a skewed channel is recorded late (sign −1: early).
 
-    A run's first samples of it are held values, not predictions (its true values lie
-    before the start).
+    A run's first samples of a late channel are held values, not predictions (its true
+    values lie before the start); an early one reads past the run's end.
     """
     on = rows[:, layout.R_CS_ON] > 0.0
-    late = np.where(on, np.maximum(rows[:, column], 0.0) * rate_hz, 0.0)
-    return np.ceil(late).astype(np.int64)[:, None, None]
+    late = np.where(on, np.maximum(sign * rows[:, column], 0.0) * rate_hz, 0.0)
+    # A whole number of samples stays itself whatever the rate's last digit (2 ms at
+    # 1999.9999… Hz or at 2000 Hz: 4 samples).
+    return np.ceil(late - 1e-6).astype(np.int64)[:, None, None]

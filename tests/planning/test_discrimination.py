@@ -101,13 +101,14 @@ def test_the_floor_is_the_noise_on_a_taut_fibre_and_more_after_snatches() -> Non
         _recorded(stand, (SKEW,), x, rate, noisy=True), stand, (SKEW,), (GAUGE,), NOISE_U, NOISE_F
     )
     assert taut.channel_floor == pytest.approx((1.0, 1.0), rel=0.05)  # 1 noise unit each
-    # snatches: restarts from states estimated on noisy channels miss more than the noise,
-    # for the right model too; the rivals' difference counts against that floor
+    # snatches: restarts from states estimated on noisy channels miss a little more than
+    # the noise, for the right model too (each start refined over its warm-up: 1.09; from
+    # the cubic fit alone 2.0 and more); the rivals' difference counts against that floor
     x, stand, rate = _motion(Shape.RECTANGULAR, 10.0, 1.5, 3.096)
     snatched = shooting_separation(
         _recorded(stand, (SKEW,), x, rate, noisy=True), stand, (SKEW,), (GAUGE,), NOISE_U, NOISE_F
     )
-    assert max(snatched.channel_floor) > 2.0
+    assert 1.0 < max(snatched.channel_floor) < 1.3
     ratios = [
         m / max(f, 1.0) for m, f in zip(snatched.channel_miss, snatched.channel_floor, strict=True)
     ]

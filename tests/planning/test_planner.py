@@ -128,8 +128,12 @@ def test_the_plan_is_admissible_and_its_separation_is_what_the_rivals_do() -> No
 
 
 def test_the_planned_test_runs_longer_than_the_motions_searched() -> None:
+    # Motions of at most 40 mm, whose lengthened runs stay admissible: eight cycles of a
+    # 70 mm, 1 Hz trapezoid are not (the light weight slack 63 % of the time, 98 mm of
+    # travel), and a plan that picks it keeps it short.
     config = default_config()
-    grid = motion_grid(config.drive, [3.096, 8.131])[:24]
+    grid = [c for c in motion_grid(config.drive, [3.096, 8.131]) if c.spec.amplitude_m <= 0.04]
+    grid = grid[:24]
     assert all(c.spec.cycles == max(2, round(MOTION_S * c.spec.frequency_hz)) for c in grid)
     plan = search(_setting(), grid, budget_s=600.0)
     assert plan.best is not None and plan.best not in grid
