@@ -4,8 +4,8 @@ A segment restarts from the weight's u and v estimated by a local cubic fit of t
 recorded u (``sim.identify.shooting``). On a taut fibre the weight rings on it at
 √(k/m), lightly damped, and a velocity error δv starts a ringing of δv/ω in u and
 δv·√(k·m) in F that lasts the whole segment: on the check's recordings the true model,
-restarted so, left 1.3–11× the noise held out where one open-loop run left 1.0–1.1, and
-from the true v 1.0–1.25. A polynomial cannot do better (its window either lets in the
+restarted so, left up to 11× the noise held out where one open-loop run left 1.0–1.3,
+and from the true v 1.0–1.25. A polynomial cannot do better (its window either lets in the
 gauge noise or bends over the ringing); the model can, because it knows the ringing.
 
 So every later segment's (u, v) is corrected by the recordings over a window after its
@@ -48,8 +48,9 @@ HOLD_SPREADS = 3.0
 #: only up to the form its candidate lacks (backlash, a curvature: tens of µm). With the
 #: fit's own spread the other stand's dial gauge (18 µm of backlash) had a time skew
 #: named beside it; widened, the check's restarts are as good or better (a heavy quick
-#: recording: 1.50 → 1.00 noise units). Only the force (u's prior narrow) let a drifting
-#: force zero into the starts; only the force where taut let a ringing load cell's.
+#: recording: 1.50 → 1.00 noise units). Weighing the force alone where the fibre is taut
+#: (the dial gauge only where slack) let a drifting force zero and a ringing load cell
+#: into the starts instead.
 U_PRIOR_WIDENING = 10.0
 #: The starts are moved by this share of the prior's spread to get the sensitivities.
 PROBE_SHARE = 0.1
@@ -57,7 +58,7 @@ PROBE_SHARE = 0.1
 
 @dataclass(frozen=True)
 class StartWindow:
-    """What refines the segment starts: the recorded force after each, and its noise.
+    """What refines the segment starts: the recorded channels after each, and their noise.
 
     Attributes
     ----------
