@@ -257,6 +257,7 @@ def start_window(trace: Trace, samples: int, half_width_s: float) -> StartWindow
         trace.noise_force_n,
         spread * float(np.linalg.norm(level)),
         spread * float(np.linalg.norm(rate)),
+        u - residual,
     )
 
 

@@ -20,7 +20,9 @@ a force gauge's drifting zero) moves the start only as far as the other allows; 
 prior is widened (``U_PRIOR_WIDENING``) so that on a taut fibre the force has its say
 on u too. A channel recorded late has no prediction in its first samples (their true
 values lie before the start): those weigh nothing; for one recorded early the window's
-runs go on past it.
+runs go on past it. The u reading is compared from where the row reads the start: a row
+whose gauge scale is not the recordings' (a dial gauge's gain being tried) reads every
+restart off by a level no start explains, and that level must not move the start.
 The window lies before the segment's scored body, so its predictions stay predictions:
 the start comes from measurements, never from a fitted trajectory. Runs there are not
 chained (the carried states start quasi-static).
@@ -72,6 +74,8 @@ class StartWindow:
         The gauges' noise, m and N rms (the residuals' units).
     spread_u_m, spread_v_m_s
         The starting estimate's spread at every sample (the prior), recorded units.
+    fit_u_m
+        The local fit's u at every sample (what the starts come from), m.
     """
 
     samples: int
@@ -82,6 +86,7 @@ class StartWindow:
     noise_force_n: float
     spread_u_m: FloatArray
     spread_v_m_s: FloatArray
+    fit_u_m: FloatArray
 
     @property
     def usable(self) -> bool:
@@ -140,7 +145,9 @@ def refined_starts(
     jf = _sensitivities(f3, probe_u, probe_v) / window.noise_force_n  # (sets, seg, width, 2)
     ju = _sensitivities(u3, probe_u, probe_v) / window.noise_u_m
     rf = (window.force_n[idx][None] - f0) / window.noise_force_n
-    ru = (window.u_m[idx][None] - u0) / window.noise_u_m
+    # u against the row's own reading of the start (``_reading_jump``).
+    jump = _reading_jump(window, u0, at, rows, rate_hz)
+    ru = (window.u_m[idx][None] - u0 - jump) / window.noise_u_m
     offsets = np.arange(width)[None, None, :]
     wf = (weight[None] * (offsets >= _late(rows, layout.R_CS_FORCE, rate_hz)))[..., None]
     wu = (weight[None] * (offsets >= _late(rows, layout.R_CS_DISP, rate_hz)))[..., None]
@@ -157,6 +164,26 @@ def refined_starts(
     out[:, later, layout.I_U] += step[..., 0]
     out[:, later, layout.I_V] += step[..., 1]
     return out
+
+
+def _reading_jump(
+    window: StartWindow, u0: FloatArray, at: IntArray, rows: FloatArray, rate_hz: float
+) -> FloatArray:
+    """Per row and segment (sets, segments, 1): where the u reading starts off the fit's.
+
+    A row whose reading of the start is not the recorded one (a dial gauge's gain other
+    than the scale the recordings show, ``dial_slope``; the baseline without the gauge
+    scale) reads every restart off by its scale's error times u, a constant over the
+    window that no start explains: left in, it pulled u to the hold and bent v to meet
+    it (a 0.8 % gain: 75 µm and 4 mm/s, and the gain's score test on top of a force
+    gauge low-pass rose from 0 to 0.04 of the remainder). Read where the run's reading
+    is a prediction (a late channel's first samples are held values); 0 where the row
+    reads its start as recorded.
+    """
+    first = np.minimum(_late(rows, layout.R_CS_DISP, rate_hz)[:, 0, 0], u0.shape[2] - 1)
+    start_reading = u0[np.arange(u0.shape[0]), :, first]  # (sets, segments)
+    fitted = window.fit_u_m[np.minimum(at[None, :] + first[:, None], window.fit_u_m.size - 1)]
+    return np.asarray((fitted - start_reading)[..., None], dtype=np.float64)
 
 
 def _sensitivities(runs3: FloatArray, probe_u: FloatArray, probe_v: FloatArray) -> FloatArray:

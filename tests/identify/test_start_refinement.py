@@ -9,6 +9,7 @@ import pytest
 
 from drivers.signals import Shape, SignalSpec, plan_motion
 from sim.config import StandConfig, default_config
+from sim.effects.registry import EffectSpec
 from sim.identify.fitting import Candidate, simulate_values
 from sim.identify.heldout import Outputs, heldout_error, noise_floor
 from sim.identify.shooting import segment_trace
@@ -161,7 +162,46 @@ def test_a_window_the_start_cannot_explain_moves_it_at_most_three_spreads(
 
 def test_start_windows_are_not_usable_without_noise() -> None:
     ones = np.ones(10)
-    quiet = StartWindow(50, 0 * ones, 0 * ones, ones > 0, 5e-7, 0.0, ones, ones)
+    quiet = StartWindow(50, 0 * ones, 0 * ones, ones > 0, 5e-7, 0.0, ones, ones, 0 * ones)
     assert not quiet.usable
     assert dataclasses.replace(quiet, noise_force_n=0.02).usable
     assert not dataclasses.replace(quiet, noise_force_n=0.02, noise_u_m=0.0).usable
+
+
+def _refined_steps(
+    trace: Trace, params: StandParams, model: Model, variant: dict[str, float]
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Each later start's refinement step in u and v (recorded units), and u's spread."""
+    seg = trace.segments
+    assert seg.window is not None
+    rows = model._rows([variant])
+    x_rel = runs.check_input(trace.x_m, trace.rate_hz)
+    init, seats = starts.start_states(
+        rows, x_rel, trace.rate_hz, seg.starts, seg.u_m, seg.v_m_s, seg.force_n, seg.dial_slope
+    )
+    scale = seg.dial_slope * rows[:, layout.P_PROJ] if np.isfinite(seg.dial_slope) else np.ones(1)
+    out = refined_starts(
+        x_rel, trace.rate_hz, rows, params.friction, seg.starts, seg.lengths, init, seats,
+        seg.window, scale, model.substeps, serial=True,
+    )  # fmt: skip
+    step = (out[0, 1:] - init[0, 1:]) * scale[0]
+    later = seg.starts[1:]
+    return step[:, layout.I_U], step[:, layout.I_V], U_PRIOR_WIDENING * seg.window.spread_u_m[later]
+
+
+def test_a_gauge_scale_the_row_does_not_share_leaves_the_starts_alone(
+    stand: StandConfig,
+) -> None:
+    # A dial gauge's gain of 0.8 % on a recording without one: the row reads every
+    # restart off by 0.8 % of u (0.2 mm at 25 mm), a level no start explains. The u
+    # steps are the true model's (the recording's own start errors), not pulled to the
+    # hold (they were, every one: 2.8–3.1 spreads). v may differ: the row reads the
+    # weight's motion 0.8 % fast, and its start velocity is that reading's.
+    trace, _, _, params = _recording(stand, 8.131, RECT, seed=3)
+    base_u, _, spread_u = _refined_steps(trace, params, Model(params, []), {})
+    gauge = Model(params, [EffectSpec("dial_gauge_calibration")])
+    for gain in (0.008, -0.008):
+        u, _, _ = _refined_steps(trace, params, gauge, {"dial_gauge_calibration.gain_error": gain})
+        off = np.abs(u - base_u) / spread_u
+        assert np.median(off) < 0.2
+        assert np.mean(off < 0.5) > 0.8
