@@ -222,11 +222,14 @@ def test_a_single_effect_of_another_form_names_no_second_effect(stand: StandConf
     # and 9 µm of backlash, which our gauge candidate lacks. A time skew soaked up the
     # backlash as a second effect; a quadratic term of the library did as well, so it
     # was set aside. With the starts refined by both gauges over each warm-up (the
-    # backlash no longer moves them), the skew does not pass its own test.
+    # backlash no longer moves them), the skew does not pass its own test. Judged with
+    # every candidate, as the diagnosis runs: among these three alone the skew, freeing
+    # the baseline's k and c from the gauge's form, passes in F by 1.05 → 1.00 noise
+    # units (p 0.008), the gauge's remainder moved to the recorded start of each run.
     rng = CaseSpec("dial_gauge_calibration", LIGHT, 0, 1).rng()
     traces, _, _ = make_campaign(
         stand, "dial_gauge_calibration", LIGHT, rng, truth_stand="other",
         other_campaign=recording_set("moderate", stand),
     )  # fmt: skip
-    result = diagnose(traces, stand.stand_params("final", LIGHT), CANDIDATES)
+    result = diagnose(traces, stand.stand_params("final", LIGHT))
     assert [e.effect for e in result.effects] == ["dial_gauge_calibration"]
