@@ -205,25 +205,3 @@ def test_a_gauge_scale_the_row_does_not_share_leaves_the_starts_alone(
         off = np.abs(u - base_u) / spread_u
         assert np.median(off) < 0.2
         assert np.mean(off < 0.5) > 0.8
-
-
-def test_each_restart_reads_u_where_the_recording_does(stand: StandConfig) -> None:
-    # The physical start is on the recordings' gauge scale; a row with a dial gauge gain
-    # of its own reads u·(1 + gain). Without its reading moved to the recorded start, a
-    # 1 % gain read every segment off by 1 % of u (0.1–1.6 mm here), a level no start
-    # explains; moved, what the gain changes is the motion after each start.
-    trace, _, _, params = _recording(stand, 8.131, RECT, seed=5)
-    seg = trace.segments
-    gain = 0.01
-    base = Model(params, []).run_segments(trace.x_m, trace.rate_hz, seg.restarts)[0]
-    gauge = Model(params, [EffectSpec("dial_gauge_calibration")]).run_segments(
-        trace.x_m, trace.rate_hz, seg.restarts, [{"dial_gauge_calibration.gain_error": gain}]
-    )[0]
-    later = seg.starts[1:]
-    # Each later segment's first reading is the baseline's (the recording's local fit,
-    # moved by the refinement's step; the steps differ where the window's motion, read
-    # 1 % fast, is millimetres: 40 µm at most).
-    assert seg.window is not None
-    first = np.abs(gauge[0, 1:, 0] - base[0, 1:, 0])
-    assert np.median(first) < NOISE_U_M
-    assert np.all(first < 0.5 * gain * np.abs(seg.window.fit_u_m[later]))
