@@ -228,24 +228,18 @@ class Model:
             rows, x_rel, rate_hz, restarts.starts, restarts.u_m, restarts.v_m_s,
             restarts.force_n, restarts.dial_slope,
         )  # fmt: skip
-        reading_offset = np.zeros(init.shape[:2])
         if restarts.window is not None:
             slope = restarts.dial_slope
             known = np.isfinite(slope) and slope > 0
             scale = slope * rows[:, layout.P_PROJ] if known else np.ones(rows.shape[0])
-            refined = refined_starts(
+            init = refined_starts(
                 x_rel, rate_hz, rows, self.stand.friction, restarts.starts, restarts.lengths,
                 init, seats, restarts.window, scale, self.substeps, serial,
             )  # fmt: skip
-            init, reading_offset = refined.init, refined.reading_offset_m
-        u, f = runs.simulate_segments(
+        return runs.simulate_segments(
             x_rel, rate_hz, rows, self.stand.friction, restarts.starts, restarts.lengths, init,
             self.substeps, chained=self.chained, serial=serial, seats=seats,
         )  # fmt: skip
-        # Each restart's u reading starts where the recording's does: the physical start
-        # is on the recordings' gauge scale, and a row's own (a dial gauge's gain being
-        # tried) would otherwise read it off by a level through the whole segment.
-        return u + reading_offset[..., None], f
 
     def stream(self, rate_hz: float, x0_m: float = 0.0) -> ModelStream:
         """The model at static rest with the drive at ``x0_m``, advanced block by block.

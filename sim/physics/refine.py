@@ -42,7 +42,7 @@ FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
 BoolArray = NDArray[np.bool_]
 
-__all__ = ["RefinedStarts", "StartWindow", "refined_starts"]
+__all__ = ["StartWindow", "refined_starts"]
 
 #: The correction is held within this many of the prior's spreads.
 HOLD_SPREADS = 3.0
@@ -94,19 +94,6 @@ class StartWindow:
         return bool(self.samples > 1 and self.noise_u_m > 0 and self.noise_force_n > 0)
 
 
-@dataclass(frozen=True)
-class RefinedStarts:
-    """The refined starts, and where each segment's u reading must be moved to start.
-
-    ``reading_offset_m`` (sets, segments): added to a segment's whole u reading, so that
-    it starts where the recording's does whatever the row's gauge scale
-    (``_reading_jump``); 0 for the first segment and where nothing was refined.
-    """
-
-    init: FloatArray
-    reading_offset_m: FloatArray
-
-
 def refined_starts(
     x_rel_m: FloatArray,
     rate_hz: float,
@@ -120,16 +107,15 @@ def refined_starts(
     scale: FloatArray,
     substeps: int,
     serial: bool,
-) -> RefinedStarts:
+) -> FloatArray:
     """``init`` (sets, segments, N_INIT) with every later segment's u and v refined.
 
     ``scale`` (sets,): each row's recorded-to-model factor of u (the dial gauge's G, as
-    ``gauges.true_channels`` divides by it). Returns new arrays; ``init`` is untouched.
+    ``gauges.true_channels`` divides by it). Returns a new array; ``init`` is untouched.
     """
     later = np.flatnonzero(starts > 0)
-    reading = np.zeros(init.shape[:2])
     if not window.usable or later.size == 0:
-        return RefinedStarts(init, reading)
+        return init
     span = np.minimum(window.samples, lengths[later]).astype(np.int64)
     # A channel recorded early reads past the window: its runs go on that far.
     early = int(max(_late(rows, layout.R_CS_FORCE, rate_hz, -1.0).max(),
@@ -140,7 +126,7 @@ def refined_starts(
     prior_v = window.spread_v_m_s[at][None, :] / scale[:, None]
     known = (prior_u > 0) & (prior_v > 0) & np.isfinite(prior_u) & np.isfinite(prior_v)
     if not known.any():
-        return RefinedStarts(init, reading)
+        return init
     prior_u, prior_v = np.where(known, prior_u, 1.0), np.where(known, prior_v, 1.0)
     probe_u, probe_v = PROBE_SHARE * prior_u, PROBE_SHARE * prior_v
     probes = np.repeat(init[:, later], 3, axis=0)  # per row: as is, u moved, v moved
@@ -177,8 +163,7 @@ def refined_starts(
     out = init.copy()
     out[:, later, layout.I_U] += step[..., 0]
     out[:, later, layout.I_V] += step[..., 1]
-    reading[:, later] = jump[..., 0]
-    return RefinedStarts(out, reading)
+    return out
 
 
 def _reading_jump(

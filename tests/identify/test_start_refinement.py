@@ -146,7 +146,7 @@ def test_a_window_the_start_cannot_explain_moves_it_at_most_three_spreads(
     out = refined_starts(
         x_rel, trace.rate_hz, rows, params.friction, seg.starts, seg.lengths, init, seats,
         window, scale, model.substeps, serial=True,
-    ).init  # fmt: skip
+    )  # fmt: skip
     moved_u = np.abs(out[0, 1:, layout.I_U] - init[0, 1:, layout.I_U]) * scale[0]
     moved_v = np.abs(out[0, 1:, layout.I_V] - init[0, 1:, layout.I_V]) * scale[0]
     spread_u = U_PRIOR_WIDENING * window.spread_u_m[seg.starts[1:]]
@@ -183,7 +183,7 @@ def _refined_steps(
     out = refined_starts(
         x_rel, trace.rate_hz, rows, params.friction, seg.starts, seg.lengths, init, seats,
         seg.window, scale, model.substeps, serial=True,
-    ).init  # fmt: skip
+    )  # fmt: skip
     step = (out[0, 1:] - init[0, 1:]) * scale[0]
     later = seg.starts[1:]
     return step[:, layout.I_U], step[:, layout.I_V], U_PRIOR_WIDENING * seg.window.spread_u_m[later]
