@@ -135,18 +135,7 @@ def test_a_window_the_start_cannot_explain_moves_it_at_most_three_spreads(
         jumped_u[s : s + seg.window.samples] += 1e-3
         jumped_f[s : s + seg.window.samples] += 1000.0
     window = dataclasses.replace(seg.window, u_m=jumped_u, force_n=jumped_f)
-    model = Model(params, [])
-    rows = model._rows([{}])  # the rows the refinement runs
-    x_rel = runs.check_input(trace.x_m, trace.rate_hz)
-    init, seats = starts.start_states(
-        rows, x_rel, trace.rate_hz, seg.starts, seg.u_m, seg.v_m_s, seg.force_n, seg.dial_slope
-    )
-    known = np.isfinite(seg.dial_slope)
-    scale = seg.dial_slope * rows[:, layout.P_PROJ] if known else np.ones(1)
-    out = refined_starts(
-        x_rel, trace.rate_hz, rows, params.friction, seg.starts, seg.lengths, init, seats,
-        window, scale, model.substeps, serial=True,
-    )  # fmt: skip
+    init, out, scale = _refine(trace, params, Model(params, []), {}, window)
     moved_u = np.abs(out[0, 1:, layout.I_U] - init[0, 1:, layout.I_U]) * scale[0]
     moved_v = np.abs(out[0, 1:, layout.I_V] - init[0, 1:, layout.I_V]) * scale[0]
     spread_u = U_PRIOR_WIDENING * window.spread_u_m[seg.starts[1:]]
@@ -168,13 +157,12 @@ def test_start_windows_are_not_usable_without_noise() -> None:
     assert not dataclasses.replace(quiet, noise_force_n=0.02, noise_u_m=0.0).usable
 
 
-def _refined_steps(
-    trace: Trace, params: StandParams, model: Model, variant: dict[str, float]
+def _refine(
+    trace: Trace, params: StandParams, model: Model, variant: dict[str, float], window: StartWindow
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Each later start's refinement step in u and v (recorded units), and u's spread."""
+    """The starts as estimated and as refined over ``window``, and each row's u scale."""
     seg = trace.segments
-    assert seg.window is not None
-    rows = model._rows([variant])
+    rows = model._rows([variant])  # the rows the refinement runs
     x_rel = runs.check_input(trace.x_m, trace.rate_hz)
     init, seats = starts.start_states(
         rows, x_rel, trace.rate_hz, seg.starts, seg.u_m, seg.v_m_s, seg.force_n, seg.dial_slope
@@ -182,8 +170,18 @@ def _refined_steps(
     scale = seg.dial_slope * rows[:, layout.P_PROJ] if np.isfinite(seg.dial_slope) else np.ones(1)
     out = refined_starts(
         x_rel, trace.rate_hz, rows, params.friction, seg.starts, seg.lengths, init, seats,
-        seg.window, scale, model.substeps, serial=True,
+        window, scale, model.substeps, serial=True,
     )  # fmt: skip
+    return init, out, scale
+
+
+def _refined_steps(
+    trace: Trace, params: StandParams, model: Model, variant: dict[str, float]
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Each later start's refinement step in u and v (recorded units), and u's spread."""
+    seg = trace.segments
+    assert seg.window is not None
+    init, out, scale = _refine(trace, params, model, variant, seg.window)
     step = (out[0, 1:] - init[0, 1:]) * scale[0]
     later = seg.starts[1:]
     return step[:, layout.I_U], step[:, layout.I_V], U_PRIOR_WIDENING * seg.window.spread_u_m[later]
