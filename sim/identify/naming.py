@@ -261,6 +261,8 @@ def further_effect(
         ev.corrected_p(len(tries)),
         effect_params(effect, fitted.result.values),
         bound_params(fitted.result, effect),
+        # Judged as the first effect's rivals are: on top of the same named ones.
+        indistinguishable(effect, fits, evidence, traces, len(tries)),
     )
     return (line, fitted), sims
 

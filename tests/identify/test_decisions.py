@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from typing import cast
 
 import numpy as np
 import pytest
@@ -13,16 +14,18 @@ from sim.config import StandConfig
 from sim.effects import EffectSpec
 from sim.effects.realism import MeasurementNoise, NoiseSpec, draw_real_stand
 from sim.identify import diagnose, make_trace
-from sim.identify.decide import Evidence, family_p_values, p_value_of_gains
-from sim.identify.fitting import FreeParam
-from sim.identify.heldout import Outputs
+from sim.identify.decide import Evidence, family_p_values, judge, p_value_of_gains
+from sim.identify.fitting import FitResult, FreeParam
+from sim.identify.heldout import Outputs, heldout_excess
 from sim.identify.naming import (
     SECOND_STAGE,
     beats,
     beyond_reach,
+    indistinguishable,
     second_tries,
     strongest_accepted,
 )
+from sim.identify.refitting import Fitted
 from sim.identify.report import Diagnosis, RankedEffect
 from sim.identify.traces import Trace
 from sim.model import Model
@@ -211,6 +214,31 @@ def test_a_runner_up_a_hair_behind_on_every_block_is_not_told_apart(stand: Stand
     assert not beats(traces, chosen, hair)  # … yet no difference X can resolve
     assert beats(traces, chosen, outputs(3.0))
     assert not beats(traces, outputs(3.0), chosen)
+
+
+def test_a_further_effect_names_the_rivals_that_predict_as_well_on_top(
+    stand: StandConfig,
+) -> None:
+    # On top of the named ones, two candidates pass and predict the held-out cycles
+    # alike (a side load and a pulley's inertia both hold the weight back): the one
+    # named lists the other, as the first effect does; a third that passes but
+    # predicts clearly worse is not listed.
+    traces = _campaign(stand, [], 5) + _campaign(stand, [], 6)
+    rng = np.random.default_rng(6)
+    named = _recorded_plus_noise(traces, rng, 3.0, 3.0)
+    outputs = {
+        "side_load_friction": _recorded_plus_noise(traces, rng, 1.5, 1.5),
+        "pulley_inertia_friction": _recorded_plus_noise(traces, rng, 1.52, 1.52),
+        "fibre_viscoelastic": _recorded_plus_noise(traces, rng, 2.4, 2.4),
+    }
+    evidence = judge(traces, named, outputs)
+    assert all(ev.accepted(len(outputs)) for ev in evidence.values())
+    fits = {
+        name: Fitted(cast("FitResult", None), outs, heldout_excess(traces, outs))
+        for name, outs in outputs.items()
+    }
+    rivals = indistinguishable("side_load_friction", fits, evidence, traces, len(fits))
+    assert rivals == ["pulley_inertia_friction"]
 
 
 def test_a_gain_in_a_channel_the_named_forms_cannot_reach_is_judged_there_alone(
