@@ -68,15 +68,20 @@ def signature_rival(
 
     A further effect, on top of those ``named``, must itself beat the richer forms the
     named effects declare (``EffectInfo.richer``), fitted to their model's remainder
-    each alone and all together (``fit_together``: a form can be off in several ways at
-    once), whether those pass or not: a further effect that does no better only soaks up
-    the named ones' form mismatch (the other stand's dial gauge, with curvature and
-    backlash, had its backlash named as a time skew). A mismatch of their form shows
-    only in the channels their richer forms act in, so a further effect that also beats
-    the named model in a channel none of them reaches (``beyond_reach``) explains
-    something their mismatch cannot: a Maxwell branch behind the other stand's dial
-    gauge, whose gain in u a velocity term in u matched, took the force from 2.49 to
-    1.37 noise units (p 2·10⁻⁹), which the gauge cannot move. Either way passes at half
+    each alone, whether those pass or not: a further effect that does no better only
+    soaks up the named ones' form mismatch (the other stand's dial gauge, with curvature
+    and backlash, had its backlash named as a time skew). A gauge's reading can be off
+    in several ways at once, so the forms in the gauges' readings are also fitted
+    together (``fit_together``): with a position or a velocity term in u alone, a
+    Maxwell branch behind that gauge fitted u better and was named. Forms through the
+    stand's dynamics are not: together they describe almost any missing force (a
+    strain and a velocity term together set aside a branch behind a side load). A
+    mismatch of their form shows only in the channels their richer forms act in, so a
+    further effect that also beats the named model in a channel none of them reaches
+    (``beyond_reach``) explains something their mismatch cannot: a Maxwell branch
+    behind the other stand's dial gauge, whose gain in u a velocity term in u matched,
+    took the force from 2.49 to 1.37 noise units (p 2·10⁻⁹), which the gauge cannot
+    move. Either way passes at half
     ``DISTINCT_P`` (a time skew behind that dial gauge with backlash: F 1.19 to 1.04,
     p 0.035, set aside). A gauge's form still leaks into F a little (the weight's start
     is read through it): refitted on F alone, its model does not move (F dominates the
@@ -92,8 +97,9 @@ def signature_rival(
         return name if beats(traces, fits[name].outputs, effect) else None
     richer = list(dict.fromkeys(form for n in named for form in EFFECTS[n].richer))
     excess = {s.name: s.excess_after for s in signatures if (s.kind, s.channel) in richer}
-    if len(richer) > 1:
-        together = fit_together(traces, before, nominal, values, richer)
+    readings = [form for form in richer if form[1] in CHANNELS]
+    if len(readings) > 1:
+        together = fit_together(traces, before, nominal, values, readings)
         fits[together.name] = together
         excess[together.name] = heldout_excess(traces, together.outputs)
     if not excess:
