@@ -1,8 +1,9 @@
 """``labstand plan``'s parts: the rivals a diagnosis leaves, the search, the answer.
 
-The rivals (``rivals_of``): the named effect against each candidate the recordings could
-not tell from it (``indistinguishable_from``); failing those, against the runner-up of the
-ranking and against the baseline alone; with nothing named, each of the ranking's
+The rivals (``rivals_of``): each named effect against each candidate the recordings could
+not tell from it (``indistinguishable_from``; the rival in its place among the named
+ones); failing those, the first against the runner-up of the ranking and against the
+baseline alone; with nothing named, each of the ranking's
 ``MAX_UNNAMED`` best against the baseline. Each rival is the diagnosis' fitted baseline plus
 its effect at the parameters its own refit found (the ranking's ``params``).
 
@@ -60,13 +61,16 @@ def rivals_of(fitted: FittedStand) -> tuple[list[Rival], list[tuple[str, str]]]:
     named = list(fitted.effects)
     ranked = [name for name in fitted.rivals if name not in {e.name for e in named}]
     pairs: list[tuple[str, str]] = []
-    if named:
-        first = named[0].name
-        others = [n for n in fitted.indistinguishable.get(first, []) if n in fitted.rivals]
-        if not others:
-            others = [*ranked[:1], BASELINE]
-        pairs = [(first, other) for other in others]
-    elif ranked:
+    #: Which named effect (by its place) each rival would stand in for.
+    replaces: dict[str, int] = {}
+    for place, effect in enumerate(named):  # the first effect's rivals first
+        for other in fitted.indistinguishable.get(effect.name, []):
+            if other in fitted.rivals and other not in replaces:
+                replaces[other] = place
+                pairs.append((effect.name, other))
+    if named and not pairs:
+        pairs = [(named[0].name, other) for other in [*ranked[:1], BASELINE]]
+    elif ranked and not named:
         pairs = [(name, BASELINE) for name in ranked[:MAX_UNNAMED]]
     if not pairs:
         raise CommandError(
@@ -80,10 +84,12 @@ def rivals_of(fitted: FittedStand) -> tuple[list[Rival], list[tuple[str, str]]]:
     for name in {n for pair in pairs for n in pair}:
         if name == BASELINE:
             models[name] = Rival(name, rest)
-        elif named and name == named[0].name:
+        elif name in {e.name for e in named}:
             models[name] = Rival(name, tuple(named))
-        else:
-            models[name] = Rival(name, (EffectSpec(name, fitted.rivals[name]), *rest))
+        else:  # in place of the named effect it could not be told from (the first if none)
+            place = replaces.get(name, 0)
+            stand_in = EffectSpec(name, fitted.rivals[name])
+            models[name] = Rival(name, (*named[:place], stand_in, *named[place + 1 :]))
     return [models[n] for n in sorted(models)], pairs
 
 

@@ -66,6 +66,37 @@ def test_the_rivals_a_diagnosis_leaves() -> None:
         rivals_of(fitted_from_dict(_diagnosis(effects=[], ranking=[]), where))
 
 
+def test_a_further_effect_s_rival_is_planned_in_its_place() -> None:
+    # The skew named first and told apart; a side load on top of it that the recordings
+    # cannot tell from a pulley's inertia: the question left is that pair, each with
+    # the skew beside it.
+    side = {"friction_coeff": 0.05}
+    pulley = {"inertia_kg_m2": 1e-4, "bearing_torque_n_m": 0.01, "load_coeff": 0.0}
+    diagnosis = _diagnosis(
+        effect="channel_time_skew",
+        effects=[
+            {"effect": "channel_time_skew", "params": SKEW, "indistinguishable_from": []},
+            {
+                "effect": "side_load_friction",
+                "params": side,
+                "indistinguishable_from": ["pulley_inertia_friction"],
+            },
+        ],
+        ranking=[
+            {"effect": "channel_time_skew", "params": SKEW},
+            {"effect": "pulley_inertia_friction", "params": pulley},
+            {"effect": "side_load_friction", "params": side},
+        ],
+    )
+    rivals, pairs = rivals_of(fitted_from_dict(diagnosis, Path("d.json")))
+    assert pairs == [("side_load_friction", "pulley_inertia_friction")]
+    effects = {r.name: [e.name for e in r.effects] for r in rivals}
+    assert effects == {
+        "side_load_friction": ["channel_time_skew", "side_load_friction"],
+        "pulley_inertia_friction": ["channel_time_skew", "pulley_inertia_friction"],
+    }
+
+
 def test_plan_then_run_the_plan(labstand: Callable[..., Outcome], tmp_path: Path) -> None:
     diagnosis = tmp_path / "diagnosis.json"
     diagnosis.write_text(json.dumps(_diagnosis()))
