@@ -3,9 +3,9 @@
 The rivals (``rivals_of``): each named effect against each candidate the recordings could
 not tell from it (``indistinguishable_from``; the rival in its place among the named
 ones); failing those, the first against the runner-up of the ranking and against the
-baseline alone; with nothing named, each of the ranking's
-``MAX_UNNAMED`` best against the baseline. Each rival is the diagnosis' fitted baseline plus
-its effect at the parameters its own refit found (the ranking's ``params``).
+baseline alone; with nothing named, each of the ranking's ``MAX_UNNAMED`` best against
+the baseline. Each rival is the diagnosis' fitted baseline plus its effect at the
+parameters its own refit found (the ranking's ``params``).
 
 Second, the plan narrows the widest interval (``widest_interval``: the named effects'
 parameter whose 95 % interval is widest against its value): among motions that tell every

@@ -81,11 +81,11 @@ def signature_rival(
     (``beyond_reach``) explains something their mismatch cannot: a Maxwell branch
     behind the other stand's dial gauge, whose gain in u a velocity term in u matched,
     took the force from 2.49 to 1.37 noise units (p 2·10⁻⁹), which the gauge cannot
-    move. Either way passes at half
-    ``DISTINCT_P`` (a time skew behind that dial gauge with backlash: F 1.19 to 1.04,
-    p 0.035, set aside). A gauge's form still leaks into F a little (the weight's start
-    is read through it): refitted on F alone, its model does not move (F dominates the
-    cost), yet a skew behind it gained 1.05 to 1.00 there (p 0.017).
+    move. Either way passes at half ``DISTINCT_P`` (a time skew behind that dial gauge
+    with backlash: F 1.19 to 1.04, p 0.035, set aside). A gauge's form still leaks into
+    F a little (the weight's start is read through it): refitted on F alone, its model
+    does not move (F dominates the cost), yet a skew behind it gained 1.05 to 1.00
+    there (p 0.017).
     """
     signatures, fits, _ = judge_signatures(traces, before, nominal, values)
     if not named:  # a rival with a formula: ``other`` repeats whatever repeats, every

@@ -581,7 +581,9 @@ def fit_together(
         for i in range(len(traces))
     ]
     label = ", ".join(f"{k} in {c}" for k, c in variants)
-    return remainder.fit(terms, joined, "+".join(k for k, _ in variants), "u+F", label)
+    channels = {c for _, c in variants}
+    channel = channels.pop() if len(channels) == 1 else "u+F"
+    return remainder.fit(terms, joined, "+".join(k for k, _ in variants), channel, label)
 
 
 def _added(outputs: Sequence[Outputs], predicted: Sequence[Outputs]) -> list[Outputs]:

@@ -97,7 +97,7 @@ def test_a_reading_off_in_two_ways_is_fitted_by_both_variants_together(
     alone = {f.name: f for f in fit_signatures(read, outputs, nominal, values)}
     variants = [("resonance", "F"), ("drift", "F")]
     together = fit_together(read, outputs, nominal, values, variants)
-    assert together.name == "resonance in F, drift in F"
+    assert (together.name, together.channel) == ("resonance in F, drift in F", "F")
     x_together = heldout_excess(read, together.outputs)
     x_alone = [heldout_excess(read, alone[f"{k} in {c}"].outputs) for k, c in variants]
     assert x_together < 0.7 * min(x_alone), (x_together, x_alone)
