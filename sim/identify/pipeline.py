@@ -54,6 +54,7 @@ from sim.identify.intervals import (
 )
 from sim.identify.naming import (
     MAX_EFFECTS,
+    OnTop,
     further_effect,
     indistinguishable,
     ranking_of,
@@ -317,26 +318,25 @@ def _further_effects(
     trained = {e: f.result.train_cost for e, f in judged.refits.items()}
     alone = {e: own_values(e, f.result.values) for e, f in judged.refits.items()}
     set_aside: list[str] = []  # passed, but no better than a richer form
+    memo: OnTop | None = None  # a set-aside try leaves the model: its work stands
     while len(accepted) + len(set_aside) < MAX_EFFECTS:  # each try: ~10 s of refits
         named = tuple(a.effect for a in accepted)
+        memo = memo if memo is not None and memo.named == named else OnTop(named)
         found, sims = further_effect(
             named, current, trained, alone, judged.base_fit.train_cost,
             [e for e in pool if e not in set_aside], run.traces, run.nominal, judged.x_base,
-            run.say,
+            run.say, memo,
         )  # fmt: skip
         run.simulations += sims
         if found is None:
             break
-        line, fitted = found
-        rival = signature_rival(run.traces, current.outputs, run.nominal, current.result.values,
-                                fitted.outputs, named)  # fmt: skip
-        if rival is not None:  # a form mismatch of those named: try the others
-            run.say(f"{line.effect} does no better than a {rival} term: not named")
-            displaced[line.effect] = rival
-            set_aside.append(line.effect)
+        if found.line is None or found.fitted is None:  # a form mismatch of those named
+            run.say(f"{found.effect} does no better than a {found.rival} term: not named")
+            displaced[found.effect] = str(found.rival)
+            set_aside.append(found.effect)
             continue
-        accepted.append(line)
-        current = fitted
+        accepted.append(found.line)
+        current = found.fitted
     return accepted, current
 
 
