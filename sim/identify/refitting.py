@@ -13,14 +13,10 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import cast
 
-import numpy as np
-
 from sim.effects import EFFECTS
 from sim.identify.fitting import (
     Candidate,
     FitResult,
-    Objective,
-    effect_grid_points,
     effect_grid_start,
     fit,
     least_cost_values,
@@ -210,19 +206,18 @@ def grid_again(
     can be the best at the baseline the fit has now. A heavy pulley's inertia fitted
     ×0.8 its truth with its bearing torque ×2.4 (training cost 7.5·10⁻⁴, the 95 %
     intervals holding none of the six parameters); the grid again and one short fit from
-    its best point reached the truth's basin (5.9·10⁻⁴). Returns the fit with the lowest
-    training cost and the simulations spent.
+    its best point reached the truth's basin (5.9·10⁻⁴). The grid's best point is found
+    as the first grid's is (``effect_grid_start``: by bounds, not every point on every
+    trace). Returns the fit with the lowest training cost and the simulations spent
+    (the local fits': the grids' are not counted, as in ``refit``).
     """
     best, spent = res, 0
     for effect in res.candidate.effects:
         prefix = f"{effect}."
         others = {k: v for k, v in best.values.items() if not k.startswith(prefix)}
-        points = effect_grid_points(res.candidate, others)
-        objective = Objective(res.candidate, traces, nominal)
-        costs = np.sum(objective.residuals_batch(points) ** 2, axis=1)
-        again = short_fit(res.candidate, traces, nominal,
-                          res.candidate.natural(points[int(np.argmin(costs))]))  # fmt: skip
-        spent += objective.simulations + again.evaluations
+        start = effect_grid_start(res.candidate, traces, nominal, others)
+        again = short_fit(res.candidate, traces, nominal, start)
+        spent += again.evaluations
         if again.train_cost < best.train_cost:
             best = again
     return best, spent
