@@ -28,7 +28,7 @@ from scipy.optimize import least_squares
 from sim.effects import EFFECTS
 from sim.identify.candidates import BASELINE_PARAMS, Candidate, FitResult, FreeParam
 from sim.identify.least_cost import TraceCost, least_cost_point
-from sim.identify.side_by_side import side_by_side
+from sim.identify.side_by_side import in_lanes, side_by_side
 from sim.identify.traces import Trace
 from sim.params import StandParams
 
@@ -328,39 +328,44 @@ def fit(
     values, e.g. the screening's best probe). ``ftol``: stop once an accepted step lowers
     the cost by less than this share of it (and the step went as the model predicted).
     """
-    objective = Objective(candidate, traces, nominal, stride)
+    grid = Objective(candidate, traces, nominal, stride)
     lo = np.array([p.bounds()[0] for p in candidate.params])
     hi = np.array([p.bounds()[1] for p in candidate.params])
-    best: tuple[float, FloatArray] | None = None
     starts = candidate.start_points(baseline)
     if not candidate.effects and baseline is None:
-        starts = _grid_starts(objective)
+        starts = _grid_starts(grid)
     if single_start and baseline is not None:
         middle = {p.name: 0.5 * (p.low + p.high) for p in candidate.params if p.held is None}
         starts = [candidate.internal({**middle, **baseline})]
     # Thresholds (``FreeParam.scan``) stay where the start put them: a gradient cannot
     # move a parameter whose output error changes in steps. Held form parameters stay too.
     free = np.array([not p.scan and p.held is None for p in candidate.params])
-    for start in starts:
-        z0 = np.clip(start, lo + 1e-9 * (hi - lo), hi - 1e-9 * (hi - lo))
 
-        def full(zf: FloatArray, z0: FloatArray = z0) -> FloatArray:
+    def local(k: int) -> tuple[float, FloatArray, int]:
+        """The local fit from start k: (cost, values, simulations), on its own objective."""
+        objective = Objective(candidate, traces, nominal, stride)
+        z0 = np.clip(starts[k], lo + 1e-9 * (hi - lo), hi - 1e-9 * (hi - lo))
+
+        def full(zf: FloatArray) -> FloatArray:
             z = z0.copy()
             z[free] = zf
             return z
 
         sol = least_squares(
-            lambda zf, full=full: objective.residuals(full(zf)), z0[free],
-            jac=lambda zf, full=full: objective.jacobian(full(zf), free),
+            lambda zf: objective.residuals(full(zf)), z0[free],
+            jac=lambda zf: objective.jacobian(full(zf), free),
             bounds=(lo[free], hi[free]), method="trf", x_scale="jac", max_nfev=max_nfev,
             xtol=1e-6, ftol=ftol,
         )  # fmt: skip
         cost = float(np.sum(sol.fun**2))
         log.debug("%s start %s -> cost %.6g (%d evals)", candidate.name, z0, cost, sol.nfev)
-        if best is None or cost < best[0]:
-            best = (cost, full(sol.x))
-    assert best is not None
-    return FitResult(candidate, candidate.natural(best[1]), best[0], objective.simulations)
+        return cost, full(sol.x), objective.simulations
+
+    # The starts side by side (``in_lanes``); the first of the least cost is kept.
+    local_fits = in_lanes(local, [1.0] * len(starts))
+    cost, best, _ = min(local_fits, key=lambda f: f[0])
+    sims = grid.simulations + sum(f[2] for f in local_fits)
+    return FitResult(candidate, candidate.natural(best), cost, sims)
 
 
 def scan_thresholds(

@@ -58,10 +58,11 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy import stats
 
-from sim.identify.fitting import Candidate, Objective, fit, scored_samples
+from sim.identify.fitting import Candidate, FitResult, Objective, fit, scored_samples
 from sim.identify.heldout import BLOCK_S, Outputs, _noise_scale, held_out_blocks
 from sim.identify.replicates import residual_replicates
 from sim.identify.report import Intervals
+from sim.identify.side_by_side import in_lanes
 from sim.identify.traces import Trace
 from sim.params import StandParams
 
@@ -324,9 +325,14 @@ def estimator_spread(
     fitted = {p.name: p.clipped(values[p.name]) for p in candidate.params if p.name in values}
     shifts: dict[str, list[float]] = {}
     sims = len(traces)
-    for drawn in residual_replicates(candidate, values, traces, nominal, rng, replicates):
-        res = fit(candidate, drawn, nominal, baseline=values, single_start=True,
-                  max_nfev=BIAS_EVALUATIONS)  # fmt: skip
+    drawn = residual_replicates(candidate, values, traces, nominal, rng, replicates)
+
+    def refit(k: int) -> FitResult:
+        return fit(candidate, drawn[k], nominal, baseline=values, single_start=True,
+                   max_nfev=BIAS_EVALUATIONS)  # fmt: skip
+
+    # Side by side: the replicates are drawn first, so the numbers do not depend on it.
+    for res in in_lanes(refit, [1.0] * len(drawn)):
         sims += res.evaluations
         for p in candidate.params:
             if p.name in fitted and p.held is None and not p.scan:

@@ -29,6 +29,7 @@ from sim.identify.refitting import (
 from sim.identify.remainder import judge_signatures
 from sim.identify.report import AcceptedEffect, RankedEffect
 from sim.identify.screening import screen
+from sim.identify.side_by_side import in_lanes
 from sim.identify.signature import fit_together
 from sim.identify.traces import Trace
 from sim.params import StandParams
@@ -287,19 +288,23 @@ def further_effect(
         memo.probes.update(probes)
     scores = {e: memo.scores[e] for e in others}
     tries = second_tries(others, scores, trained, base_cost)
-    fits: dict[str, Fitted] = {}
-    for effect in tries:
-        if effect in memo.fits:
-            fits[effect] = memo.fits[effect]
-            continue
+    new = [e for e in tries if e not in memo.fits]
+    candidates = [Candidate.build(*named, effect) for effect in new]
+
+    def refit_on_top(k: int) -> Fitted:
+        effect = new[k]
         say(f"refitting {effect} on top of {first}")
         probe = [memo.probes[effect]] if effect in memo.probes else []
         probe += [alone[effect]] if effect in alone else []
         shown = data_starts(effect, traces, nominal, current.result.values)
-        fits[effect] = memo.fits[effect] = refit(
-            Candidate.build(*named, effect), traces, nominal, current.result.values, probe, shown
-        )
-        sims += fits[effect].result.evaluations
+        return refit(candidates[k], traces, nominal, current.result.values, probe, shown)
+
+    # Side by side (the numbers are those of one after the other), as the first refits.
+    for effect, fitted in zip(new, in_lanes(refit_on_top, [len(c.params) for c in candidates]),
+                              strict=True):  # fmt: skip
+        memo.fits[effect] = fitted
+        sims += fitted.result.evaluations
+    fits = {effect: memo.fits[effect] for effect in tries}
     evidence = judge(traces, current.outputs, {e: f.outputs for e, f in fits.items()})
     # The best held-out error among those whose evidence holds (as for the first).
     passing = [e for e in tries if evidence[e].accepted(len(tries))]

@@ -29,6 +29,7 @@ from scipy import stats
 from sim.identify.candidates import FreeParam
 from sim.identify.fitting import Candidate, fit
 from sim.identify.intervals import ParameterIntervals, parameter_intervals
+from sim.identify.side_by_side import in_lanes
 from sim.identify.traces import Trace
 from sim.params import StandParams
 
@@ -121,14 +122,18 @@ def fit_each(
     candidate: Candidate, values: dict[str, float], traces: Sequence[Trace], nominal: StandParams
 ) -> tuple[list[RecordingFit], int]:
     """Each recording fitted alone from the campaign's values, with its intervals."""
-    fits, sims = [], 0
-    for tr in traces:
+
+    def fit_one(k: int) -> tuple[RecordingFit, int]:
+        tr = traces[k]
         res = fit(candidate, [tr], nominal, baseline=values, single_start=True,
                   max_nfev=EVALUATIONS, ftol=FTOL)  # fmt: skip
         sure = parameter_intervals(candidate, res.values, [tr], nominal)
-        sims += res.evaluations + sure.simulations
-        fits.append(RecordingFit(tr.name, res.values, sure, drive_of(tr)))
-    return fits, sims
+        sims = res.evaluations + sure.simulations
+        return RecordingFit(tr.name, res.values, sure, drive_of(tr)), sims
+
+    # Side by side, the longest recording first (the numbers are those of one after the other).
+    done = in_lanes(fit_one, [tr.samples for tr in traces])
+    return [f for f, _ in done], sum(s for _, s in done)
 
 
 def _internal(candidate: Candidate, name: str, value: float) -> float:

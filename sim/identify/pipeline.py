@@ -78,6 +78,7 @@ from sim.identify.remainder import Remainder, remainder_of, verdict
 from sim.identify.report import AcceptedEffect, Diagnosis, RankedEffect
 from sim.identify.screening import outputs_of, screen
 from sim.identify.shooting import dial_slope
+from sim.identify.side_by_side import in_lanes
 from sim.identify.traces import Trace
 from sim.identify.where import SimStates, where_the_gap_lies
 from sim.params import StandParams
@@ -214,17 +215,26 @@ def _refit_all(
     base_values: dict[str, float],
 ) -> dict[str, Fitted]:
     """Stage 3: every candidate refitted alone on the baseline, the leader's form too."""
+
+    def refit_one(k: int) -> tuple[Fitted, float]:
+        effect = order[k]
+        run.say(f"refitting {effect} (screening score {scores[effect]:.3f})")
+        started = time.perf_counter()
+        probe = [probes[effect]] if effect in probes else []
+        shown = data_starts(effect, run.traces, run.nominal, base_values)
+        fitted = refit(candidates[k], run.traces, run.nominal, base_values, probe, shown)
+        return fitted, time.perf_counter() - started
+
+    candidates = [Candidate.build(effect) for effect in order]
     refits: dict[str, Fitted] = {}
     with run.timed("refits"):
-        for effect in order:
-            run.say(f"refitting {effect} (screening score {scores[effect]:.3f})")
-            with run.timed(f"refit {effect}"):
-                probe = [probes[effect]] if effect in probes else []
-                shown = data_starts(effect, run.traces, run.nominal, base_values)
-                refits[effect] = refit(
-                    Candidate.build(effect), run.traces, run.nominal, base_values, probe, shown
-                )
-            run.simulations += refits[effect].result.evaluations
+        # Side by side (the numbers are those of one after the other); a refit's cost
+        # grows with its parameters (a Jacobian is a batch of p + 1 sets).
+        done = in_lanes(refit_one, [len(c.params) for c in candidates])
+        for effect, (fitted, seconds) in zip(order, done, strict=True):
+            refits[effect] = fitted
+            run.timings[f"refit {effect}"] = seconds
+            run.simulations += fitted.result.evaluations
         leader = min(refits, key=lambda e: refits[e].result.train_cost, default=None)
         if leader is not None:
             started = time.perf_counter()

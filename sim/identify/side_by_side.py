@@ -17,9 +17,11 @@ from typing import TypeVar
 
 import numba
 
+from sim.physics.lanes import in_serial_lane, serial_lane
+
 T = TypeVar("T")
 
-__all__ = ["side_by_side"]
+__all__ = ["in_lanes", "side_by_side"]
 
 
 def side_by_side(work: Callable[[int, bool], T], sizes: Sequence[int]) -> list[T]:
@@ -31,10 +33,37 @@ def side_by_side(work: Callable[[int, bool], T], sizes: Sequence[int]) -> list[T
     here: no pool outlives it, so no state is shared between calls); that costs about
     0.5 ms a call against some 20 ms of work (docs/benchmarks.md).
     """
+    if in_serial_lane():  # already one of several lanes: the cores are taken
+        return [work(k, True) for k in range(len(sizes))]
     threads = min(len(sizes), numba.get_num_threads())
     if threads < 2:
         return [work(k, False) for k in range(len(sizes))]
     order = sorted(range(len(sizes)), key=lambda k: -sizes[k])
     with ThreadPoolExecutor(max_workers=threads, thread_name_prefix="trace") as pool:
         futures = {k: pool.submit(work, k, True) for k in order}
+        return [futures[k].result() for k in range(len(sizes))]
+
+
+def in_lanes(work: Callable[[int], T], sizes: Sequence[float]) -> list[T]:
+    """``work(k)`` for every item k (``sizes[k]``: its guessed cost), results in order.
+
+    For independent pieces that each run many batches (a candidate's refit, a bootstrap
+    replicate): with more than one numba thread they run in threads, each a serial lane
+    (``sim.physics.lanes``: its runs on its own thread), the costliest first. A batch
+    on all cores leaves them idle while Python prepares the next one and while a model
+    whose states carry runs a segment after another; lanes fill those gaps with another
+    piece's runs. The numbers are those of one after the other. Inside a lane, or with
+    one thread, the items run one after the other here.
+    """
+    threads = min(len(sizes), numba.get_num_threads())
+    if threads < 2 or in_serial_lane():
+        return [work(k) for k in range(len(sizes))]
+
+    def lane(k: int) -> T:
+        with serial_lane():
+            return work(k)
+
+    order = sorted(range(len(sizes)), key=lambda k: -sizes[k])
+    with ThreadPoolExecutor(max_workers=threads, thread_name_prefix="lane") as pool:
+        futures = {k: pool.submit(lane, k) for k in order}
         return [futures[k].result() for k in range(len(sizes))]

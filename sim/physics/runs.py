@@ -22,6 +22,7 @@ from sim.effects.registry import EFFECTS, EffectError, EffectSpec, check_unique,
 from sim.errors import SimulationError
 from sim.params import FrictionTable, StandParams
 from sim.physics import compose, gauges, layout
+from sim.physics.lanes import in_serial_lane
 from sim.results import BatchResult, ModelRun
 
 FloatArray = NDArray[np.float64]
@@ -260,7 +261,7 @@ def simulate_segments(
     # ``chained``: string modes, bristles and the pulley seat carry over between
     # segments (see simulate_chained_into); the model decides.
     k = _kernel(rows2)
-    if serial:
+    if serial or in_serial_lane():
         kernel = k.simulate_chained_serial if chained else k.simulate_segments_serial
     else:
         kernel = k.simulate_chained_into if chained else k.simulate_segments_into
