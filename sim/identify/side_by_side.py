@@ -64,6 +64,11 @@ def in_lanes(work: Callable[[int], T], sizes: Sequence[float]) -> list[T]:
             return work(k)
 
     order = sorted(range(len(sizes)), key=lambda k: -sizes[k])
-    with ThreadPoolExecutor(max_workers=threads, thread_name_prefix="lane") as pool:
+    pool = ThreadPoolExecutor(max_workers=threads, thread_name_prefix="lane")
+    try:
         futures = {k: pool.submit(lane, k) for k in order}
         return [futures[k].result() for k in range(len(sizes))]
+    finally:
+        # A failure (or Ctrl-C) does not wait for the pieces not yet started, only for
+        # those running: their threads are joined here, none outlives the call.
+        pool.shutdown(wait=True, cancel_futures=True)

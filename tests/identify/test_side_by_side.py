@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import threading
+import time
 
 import numba
 import numpy as np
@@ -88,6 +89,24 @@ def test_a_lane_inside_a_lane_runs_in_turn_and_a_failure_reaches_the_caller() ->
 
     with pytest.raises(ValueError, match="lane 2 failed"):
         in_lanes(failing, [1.0, 1.0, 1.0])
+    assert _lane_threads() == []
+
+
+@TWO_THREADS
+def test_a_failing_lane_cancels_the_pieces_not_yet_started() -> None:
+    # A refit that fails (or Ctrl-C) must not wait for every other candidate's refit.
+    ran: list[int] = []
+
+    def work(k: int) -> int:
+        if k == 0:
+            raise RuntimeError("the first piece failed")
+        time.sleep(0.05)
+        ran.append(k)
+        return k
+
+    with pytest.raises(RuntimeError, match="first piece failed"):
+        in_lanes(work, [2.0] + [1.0] * 29)  # the first piece starts first
+    assert len(ran) < 10
     assert _lane_threads() == []
 
 
