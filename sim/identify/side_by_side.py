@@ -11,6 +11,7 @@ of the parallel kernels, which compute every item alike.
 
 from __future__ import annotations
 
+import threading
 from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from typing import TypeVar
@@ -59,8 +60,10 @@ def in_lanes(work: Callable[[int], T], sizes: Sequence[float]) -> list[T]:
     if threads < 2 or in_serial_lane():
         return [work(k) for k in range(len(sizes))]
 
+    stop = threading.Event()
+
     def lane(k: int) -> T:
-        with serial_lane():
+        with serial_lane(stop):
             return work(k)
 
     order = sorted(range(len(sizes)), key=lambda k: -sizes[k])
@@ -69,6 +72,8 @@ def in_lanes(work: Callable[[int], T], sizes: Sequence[float]) -> list[T]:
         futures = {k: pool.submit(lane, k) for k in order}
         return [futures[k].result() for k in range(len(sizes))]
     finally:
-        # A failure (or Ctrl-C) does not wait for the pieces not yet started, only for
-        # those running: their threads are joined here, none outlives the call.
+        # On a failure (or Ctrl-C, SIGTERM) the pieces not yet started are dropped and
+        # those running stop at their next run (``LaneStoppedError``, unread): the call returns
+        # after one run of each, not a whole refit. Their threads are joined here.
+        stop.set()
         pool.shutdown(wait=True, cancel_futures=True)

@@ -14,20 +14,35 @@ import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
 
-__all__ = ["in_serial_lane", "serial_lane"]
+__all__ = ["LaneStoppedError", "in_serial_lane", "serial_lane", "stop_if_asked"]
 
 _HERE = threading.local()
 
 
+class LaneStoppedError(Exception):
+    """The lanes' caller gave up (another lane failed, Ctrl-C, SIGTERM): this one stops."""
+
+
 @contextmanager
-def serial_lane() -> Iterator[None]:
-    """Every run on the calling thread inside this block is serial."""
-    before = getattr(_HERE, "serial", False)
-    _HERE.serial = True
+def serial_lane(stop: threading.Event | None = None) -> Iterator[None]:
+    """Every run on the calling thread inside this block is serial.
+
+    ``stop``: once set, the lane's next run raises ``LaneStoppedError`` (``stop_if_asked``), so a
+    caller that gives up waits for one run of each lane, not for each lane's whole work.
+    """
+    before = getattr(_HERE, "serial", False), getattr(_HERE, "stop", None)
+    _HERE.serial, _HERE.stop = True, stop
     try:
         yield
     finally:
-        _HERE.serial = before
+        _HERE.serial, _HERE.stop = before
+
+
+def stop_if_asked() -> None:
+    """Raise ``LaneStoppedError`` where the calling thread's lane was told to stop."""
+    stop = getattr(_HERE, "stop", None)
+    if stop is not None and stop.is_set():
+        raise LaneStoppedError("the lanes' caller gave up")
 
 
 def in_serial_lane() -> bool:

@@ -22,7 +22,7 @@ from sim.effects.registry import EFFECTS, EffectError, EffectSpec, check_unique,
 from sim.errors import SimulationError
 from sim.params import FrictionTable, StandParams
 from sim.physics import compose, gauges, layout
-from sim.physics.lanes import in_serial_lane
+from sim.physics.lanes import in_serial_lane, stop_if_asked
 from sim.results import BatchResult, ModelRun
 
 FloatArray = NDArray[np.float64]
@@ -254,6 +254,7 @@ def simulate_segments(
     seat's offset each row's runs hold at every sample, as the recorded slack episodes
     put it (``starts.start_states``); None: the model's own slack moves it.
     """
+    stop_if_asked()  # a lane whose caller gave up ends here, between runs
     rows2 = np.ascontiguousarray(np.atleast_2d(rows), dtype=np.float64)
     sets, segs, width = rows2.shape[0], starts.shape[0], int(lengths.max())
     u, t1 = np.empty((sets, segs, width)), np.empty((sets, segs, width))

@@ -93,6 +93,31 @@ def test_a_lane_inside_a_lane_runs_in_turn_and_a_failure_reaches_the_caller() ->
 
 
 @TWO_THREADS
+def test_a_failing_lane_stops_the_running_ones_at_their_next_run(stand: StandConfig) -> None:
+    # A refit that fails, Ctrl-C or SIGTERM must not wait for the other lanes' whole
+    # refits: each running lane stops at its next simulation.
+    trace = _trace(stand, [], 1)
+    nominal = stand.stand_params("final", 3.096)
+    base = Candidate.build()
+    z = np.array([p.to_internal(1.0) if p.name != "friction_scale" else 1.0 for p in base.params])
+    runs_done = [0, 0]
+
+    def work(k: int) -> int:
+        if k == 0:
+            time.sleep(0.3)  # the other lane is simulating by now
+            raise RuntimeError("the refit failed")
+        for _ in range(400):  # seconds of simulations, were it not stopped
+            fitting.Objective(base, [trace], nominal).residuals_batch(z[None])
+            runs_done[k] += 1
+        return k
+
+    with pytest.raises(RuntimeError, match="the refit failed"):
+        in_lanes(work, [2.0, 1.0])
+    assert 0 < runs_done[1] < 400
+    assert _lane_threads() == []
+
+
+@TWO_THREADS
 def test_a_failing_lane_cancels_the_pieces_not_yet_started() -> None:
     # A refit that fails (or Ctrl-C) must not wait for every other candidate's refit.
     ran: list[int] = []
