@@ -36,6 +36,7 @@ from sim.effects.registry import EFFECTS, EffectError, EffectSpec, check_unique
 from sim.errors import SimulationError
 from sim.params import StandParams
 from sim.physics import layout, runs, starts
+from sim.physics.lanes import LaneStoppedError, in_serial_lane, serial_lane
 from sim.physics.refine import StartWindow, refined_starts
 from sim.physics.runs import DEFAULT_SUBSTEPS, check_input
 from sim.results import BatchResult, ModelRun, SimResult
@@ -46,6 +47,7 @@ IntArray = NDArray[np.int64]
 __all__ = [
     "DEFAULT_SUBSTEPS",
     "BatchResult",
+    "LaneStoppedError",
     "Model",
     "ModelRun",
     "ModelStream",
@@ -54,6 +56,8 @@ __all__ = [
     "SimulationError",
     "StartWindow",
     "Variant",
+    "in_serial_lane",
+    "serial_lane",
 ]
 
 #: Parameter changes of one set of a batch: StandParams field or "<effect>.<param>" → value.

@@ -18,7 +18,7 @@ from typing import TypeVar
 
 import numba
 
-from sim.physics.lanes import in_serial_lane, serial_lane
+from sim.model import in_serial_lane, serial_lane
 
 T = TypeVar("T")
 

@@ -1,4 +1,4 @@
-"""Serial lanes: a thread whose every run stays on it (private: ``sim.physics.runs``).
+"""Serial lanes: a thread whose every run stays on it (used through ``sim.model``).
 
 Several independent pieces of work (candidates' refits, bootstrap replicates) can run
 side by side, one thread each, instead of one after the other on all cores. Inside such

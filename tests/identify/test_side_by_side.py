@@ -17,8 +17,7 @@ from sim.identify.fitting import Candidate, fit
 from sim.identify.intervals import estimator_spread
 from sim.identify.side_by_side import in_lanes, side_by_side
 from sim.identify.traces import Trace, make_trace
-from sim.model import Model
-from sim.physics.lanes import in_serial_lane
+from sim.model import Model, in_serial_lane
 
 TWO_THREADS = pytest.mark.skipif(
     numba.get_num_threads() < 2, reason="one numba thread runs every item in turn"
