@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 
 from sim.effects import EFFECTS
 from sim.identify.decide import Evidence, compare, judge
-from sim.identify.fitting import Candidate
+from sim.identify.fitting import Candidate, weighed_by_miss
 from sim.identify.heldout import CHANNELS, Outputs, heldout_error, heldout_excess
 from sim.identify.refitting import (
     Fitted,
@@ -290,6 +290,8 @@ def further_effect(
     tries = second_tries(others, scores, trained, base_cost)
     new = [e for e in tries if e not in memo.fits]
     candidates = [Candidate.build(*named, effect) for effect in new]
+    # Fitted in the units of the named model's miss (``weighed_by_miss``); judged as ever.
+    weighed = weighed_by_miss(traces, current.outputs)
 
     def refit_on_top(k: int) -> Fitted:
         effect = new[k]
@@ -297,7 +299,7 @@ def further_effect(
         probe = [memo.probes[effect]] if effect in memo.probes else []
         probe += [alone[effect]] if effect in alone else []
         shown = data_starts(effect, traces, nominal, current.result.values)
-        return refit(candidates[k], traces, nominal, current.result.values, probe, shown)
+        return refit(candidates[k], weighed, nominal, current.result.values, probe, shown)
 
     # Side by side (the numbers are those of one after the other), as the first refits.
     for effect, fitted in zip(new, in_lanes(refit_on_top, [len(c.params) for c in candidates]),
@@ -321,7 +323,7 @@ def further_effect(
     if rival is not None:
         return Tried(effect, rival), sims
     ev = evidence[effect]
-    fitted = polish(fits[effect], traces, nominal)
+    fitted = polish(fits[effect], weighed, nominal)
     sims += fitted.result.evaluations
     rival = signature_rival(traces, current.outputs, nominal, current.result.values,
                             fitted.outputs, named)  # fmt: skip

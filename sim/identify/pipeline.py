@@ -35,7 +35,7 @@ from typing import Any
 from sim.effects import EFFECTS
 from sim.identify.decide import Evidence, judge
 from sim.identify.dynamic_stiffness import rate_dependence
-from sim.identify.fitting import Candidate, FitResult, fit
+from sim.identify.fitting import Candidate, FitResult, fit, weighed_by_miss
 from sim.identify.heldout import (
     Outputs,
     bootstrap_confidence,
@@ -95,6 +95,8 @@ class _Run:
     say: Progress
     timings: dict[str, float] = field(default_factory=dict)
     simulations: int = 0
+    #: The traces as the final model was fitted (``weighed_by_miss``); None: ``traces``.
+    fit_traces: list[Trace] | None = None
 
     @contextmanager
     def timed(self, key: str) -> Iterator[None]:
@@ -346,6 +348,7 @@ def _further_effects(
             set_aside.append(found.effect)
             continue
         accepted.append(found.line)
+        run.fit_traces = weighed_by_miss(run.traces, current.outputs)  # as it was fitted
         current = found.fitted
     return accepted, current
 
@@ -362,10 +365,13 @@ def how_sure(
 
     The named effects' parameters are as the final model (all together) has them.
     """
+    # In the units the final model was fitted in (a further effect's: ``weighed_by_miss``),
+    # so that its values are the least cost the intervals' refits start from.
     traces, nominal = run.traces, run.nominal
     sure = parameter_intervals(
-        final.candidate, final.values, traces, nominal, replicates=BIAS_REPLICATES
-    )
+        final.candidate, final.values, run.fit_traces or traces, nominal,
+        replicates=BIAS_REPLICATES,
+    )  # fmt: skip
     for a in accepted:
         prefix = f"{a.effect}."
         a.params = effect_params(a.effect, final.values)

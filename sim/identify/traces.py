@@ -70,6 +70,9 @@ class Trace:
     #: The campaign's dial gauge slope du/dx at constant force (``shooting.dial_slope``);
     #: NaN: estimated from this trace alone.
     dial_slope: float = float("nan")
+    #: A fit's per-sample units of u (m) and F (N), in place of each channel's spread
+    #: (``fitting.Objective``): a reference model's miss (``fitting.weighed_by_miss``).
+    fit_units: tuple[float, float] | None = None
 
     @property
     def samples(self) -> int:
