@@ -16,7 +16,6 @@ fits are reproducible.
 
 from __future__ import annotations
 
-import dataclasses
 import logging
 import math
 from collections.abc import Sequence
@@ -120,7 +119,7 @@ def weighed_by_miss(traces: Sequence[Trace], reference: Sequence[Outputs]) -> li
             float(np.sqrt(np.mean((sim[idx] - rec[idx]) ** 2))) if idx.size else 0.0
             for sim, rec in ((out.u_m, tr.u_m), (out.force_n, tr.force_n))
         )
-        weighed.append(dataclasses.replace(tr, fit_units=(units[0], units[1])))
+        weighed.append(tr.with_fit_units((units[0], units[1])))
     return weighed
 
 

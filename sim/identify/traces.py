@@ -8,6 +8,7 @@ which cycle each sample belongs to, and whether it is used for fitting or held o
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 from dataclasses import dataclass
 from functools import cached_property
@@ -93,6 +94,16 @@ class Trace:
     def segments(self) -> Segments:
         """How multiple shooting cuts this trace (computed once per trace)."""
         return segment_trace(self)
+
+    def with_fit_units(self, units: tuple[float, float] | None) -> Trace:
+        """The same recording with a fit's units set; its segments are not cut again.
+
+        They depend on the recording alone (0.2 s for four recordings, per further effect).
+        """
+        weighed = dataclasses.replace(self, fit_units=units)
+        if "segments" in self.__dict__:
+            weighed.__dict__["segments"] = self.__dict__["segments"]
+        return weighed
 
 
 def drive_phases(x_m: FloatArray, rate_hz: float) -> IntArray:

@@ -63,6 +63,7 @@ def test_a_fit_in_a_reference_miss_counts_each_recorded_channel_alike(
     base = fit(Candidate.build(), traces, nominal)
     reference = outputs_of(base.candidate, base.values, traces, nominal)
     weighed = weighed_by_miss(traces, reference)
+    assert all(w.segments is tr.segments for w, tr in zip(weighed, traces, strict=True))
     z = np.array([p.to_internal(base.values[p.name]) for p in base.candidate.params])
     for tr in weighed:
         assert tr.fit_units is not None and all(u > 0 for u in tr.fit_units)
