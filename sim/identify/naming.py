@@ -23,6 +23,7 @@ from sim.identify.refitting import (
     closure,
     data_starts,
     effect_params,
+    in_their_units,
     polish,
     refit,
 )
@@ -30,7 +31,7 @@ from sim.identify.remainder import judge_signatures
 from sim.identify.report import AcceptedEffect, RankedEffect
 from sim.identify.screening import screen
 from sim.identify.side_by_side import in_lanes
-from sim.identify.signature import fit_together
+from sim.identify.signature import RICHER_ONLY, fit_together
 from sim.identify.traces import Trace
 from sim.params import StandParams
 
@@ -99,6 +100,11 @@ def signature_rival(
         return name if beats(traces, fits[name].outputs, effect) else None
     richer = list(dict.fromkeys(form for n in named for form in EFFECTS[n].richer))
     excess = {s.name: s.excess_after for s in signatures if (s.kind, s.channel) in richer}
+    for form in richer:  # the forms no remainder signature has (``RICHER_ONLY``)
+        if form[0] in RICHER_ONLY:
+            alone = fit_together(traces, before, nominal, values, [form])
+            fits[alone.name] = alone
+            excess[alone.name] = heldout_excess(traces, alone.outputs)
     readings = [form for form in richer if form[1] in CHANNELS]
     if len(readings) > 1:
         together = fit_together(traces, before, nominal, values, readings)
@@ -226,6 +232,8 @@ class OnTop:
     scores: dict[str, float] = field(default_factory=dict)
     probes: dict[str, dict[str, float]] = field(default_factory=dict)
     fits: dict[str, Fitted] = field(default_factory=dict)
+    #: The model of those named refitted in the further effects' units (``in_their_units``).
+    reference: Fitted | None = None
 
 
 @dataclass
@@ -290,10 +298,14 @@ def further_effect(
     tries = second_tries(others, scores, trained, base_cost)
     new = [e for e in tries if e not in memo.fits]
     candidates = [Candidate.build(*named, effect) for effect in new]
-    # Fitted in the units of the named model's miss (``weighed_by_miss``); judged as ever.
+    # Fitted in the units of the named model's miss (``weighed_by_miss``), and judged
+    # against that model refitted in the same units (``in_their_units``).
     weighed = weighed_by_miss(traces, current.outputs)
 
     def refit_on_top(k: int) -> Fitted:
+        if k == len(new):
+            say(f"refitting {first} in the same units")
+            return in_their_units(current, weighed, nominal)
         effect = new[k]
         say(f"refitting {effect} on top of {first}")
         probe = [memo.probes[effect]] if effect in memo.probes else []
@@ -302,12 +314,19 @@ def further_effect(
         return refit(candidates[k], weighed, nominal, current.result.values, probe, shown)
 
     # Side by side (the numbers are those of one after the other), as the first refits.
-    for effect, fitted in zip(new, in_lanes(refit_on_top, [len(c.params) for c in candidates]),
-                              strict=True):  # fmt: skip
+    sizes = [float(len(c.params)) for c in candidates]
+    if memo.reference is None:
+        sizes.append(float(len(current.result.candidate.params)))
+    done = in_lanes(refit_on_top, sizes)
+    for effect, fitted in zip(new, done, strict=False):
         memo.fits[effect] = fitted
         sims += fitted.result.evaluations
+    if memo.reference is None:
+        memo.reference = done[-1]
+        sims += done[-1].result.evaluations
+    base = memo.reference
     fits = {effect: memo.fits[effect] for effect in tries}
-    evidence = judge(traces, current.outputs, {e: f.outputs for e, f in fits.items()})
+    evidence = judge(traces, base.outputs, {e: f.outputs for e, f in fits.items()})
     # The best held-out error among those whose evidence holds (as for the first).
     passing = [e for e in tries if evidence[e].accepted(len(tries))]
     if not passing:
@@ -318,20 +337,20 @@ def further_effect(
     # 27 s of a 93 s diagnosis, for a pulley's inertia then set aside); the polished
     # fit must stand too (the other stand's light dial gauge of seed 5: a branch whose
     # refit beat the gauge's forms together, polished, did not).
-    rival = signature_rival(traces, current.outputs, nominal, current.result.values,
+    rival = signature_rival(traces, base.outputs, nominal, base.result.values,
                             fits[effect].outputs, named)  # fmt: skip
     if rival is not None:
         return Tried(effect, rival), sims
     ev = evidence[effect]
     fitted = polish(fits[effect], weighed, nominal)
     sims += fitted.result.evaluations
-    rival = signature_rival(traces, current.outputs, nominal, current.result.values,
+    rival = signature_rival(traces, base.outputs, nominal, base.result.values,
                             fitted.outputs, named)  # fmt: skip
     if rival is not None:
         return Tried(effect, rival), sims
     line = AcceptedEffect(
         effect,
-        closure(current.excess, fitted.excess, x_base),
+        closure(base.excess, fitted.excess, x_base),
         ev.corrected_p(len(tries)),
         effect_params(effect, fitted.result.values),
         bound_params(fitted.result, effect),

@@ -78,6 +78,13 @@ POSITION_ORDERS = (1, 2, 3, 4, 5)
 #: Natural frequencies of the resonance library, Hz, and its damping ratio.
 RESONANCE_HZ = (15.0, 25.0, 40.0, 60.0, 90.0, 140.0, 220.0, 350.0)
 RESONANCE_ZETA = 0.05
+#: Relaxation times of a further Maxwell branch (``RICHER_ONLY``), s: a carbon tow's
+#: spectrum is broad (its sizing's glassy response in milliseconds, the tow settling in
+#: tenths of a second).
+RELAXATION_S = (0.002, 0.005, 0.01, 0.02, 0.05, 0.1, 0.2, 0.5)
+#: Kinds that only a named effect's richer form uses (``EffectInfo.richer``), never a
+#: remainder's signature: one more relaxation branch is the catalogue's own effect.
+RICHER_ONLY = ("relaxation",)
 #: Speeds at which the velocity library's friction shapes saturate, m/s.
 VELOCITY_SCALES_M_S = (1e-3, 1e-2)
 #: Polynomial orders of the drift library (per recording and gauge).
@@ -275,6 +282,10 @@ class _Library:
                 for hz in RESONANCE_HZ
                 for route in ("tension", "F")
             ]
+        if kind == "relaxation":  # one more Maxwell branch: k·ė relaxing with τ
+            return [
+                Term(kind, "tension", f"k·branch(τ {tau * 1e3:g} ms)", "N") for tau in RELAXATION_S
+            ]
         if kind == NUISANCE:  # the baseline's own parameters, given their say again
             return [
                 Term(kind, "tension", "k·e", "N"),
@@ -312,6 +323,9 @@ class _Library:
             for hz in RESONANCE_HZ:
                 mode = _mode_response(out.force_n, hz, tr.rate_hz)
                 rows += [mode, mode]
+        elif kind == "relaxation":
+            e = self.elongation(i)
+            rows += [self.k * _branch_response(e - e[0], tau, tr.rate_hz) for tau in RELAXATION_S]
         elif kind == NUISANCE:
             rows += [self.elongation(i) * self.k, self.elongation_rate(i) * self.c]
             rows += [-np.tanh(v / self.v_reg) * self.friction_n]
@@ -347,6 +361,18 @@ def _mode_response(
     b, a = _mode_filter(hz, rate_hz, zeta)
     base = force - force[0]
     return np.asarray(lfilter(b, a, base) - base)
+
+
+@lru_cache(maxsize=64)
+def _branch_filter(tau_s: float, rate_hz: float) -> Filter:
+    b, a, _ = cont2discrete(([1.0, 0.0], [1.0, 1.0 / tau_s]), 1.0 / rate_hz, method="bilinear")
+    return np.ravel(b), np.ravel(a)
+
+
+def _branch_response(elongation: FloatArray, tau_s: float, rate_hz: float) -> FloatArray:
+    """A Maxwell branch's stretch (its force over its stiffness): s/(s + 1/τ) of e."""
+    b, a = _branch_filter(tau_s, rate_hz)
+    return np.asarray(lfilter(b, a, elongation))
 
 
 def _responses(

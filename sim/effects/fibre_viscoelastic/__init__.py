@@ -68,8 +68,8 @@ INFO = EffectInfo(
                   "cycle (≈ 1–2.5 s) it is extra stiffness that k absorbs"),
     ),
     start_state=_start_state,
-    # Richer forms: another relaxation branch or a nonlinear law: a filtered or curved tension.
-    richer=(("strain", "u+F"), ("resonance", "u+F")),
+    # Richer forms: another relaxation branch, a nonlinear law, a filtered tension.
+    richer=(("relaxation", "u+F"), ("strain", "u+F"), ("resonance", "u+F")),
     data_starts="sim.effects.fibre_viscoelastic.branch_starts:branch_starts",
 )
 # fmt: on
