@@ -26,6 +26,10 @@ tension), drift (slow polynomials in time within each recording), and ``other``:
 remainder of the training cycles, averaged cycle by cycle, predicting the held-out
 cycles' — it repeats with the motion, yet no term of the library describes it.
 
+One more kind serves only as a named effect's richer form (``RICHER_ONLY``), never as a
+remainder's signature: relaxation, a bank of Maxwell branches (``RELAXATION_S``) beside a
+named one, since a carbon tow's relaxation spectrum is broader than one time constant.
+
 Each kind is fitted by sequentially thresholded least squares (STLSQ, the optimiser of
 SINDy; Brunton, Proctor and Kutz 2016), on columns scaled to their output's noise so the
 threshold is in noise units: a term that moves the outputs by less than
