@@ -118,9 +118,9 @@ def in_their_units(fitted: Fitted, traces: Sequence[Trace], nominal: StandParams
     A further effect fitted in the units of the named model's miss gains by the units
     alone: any parameter set fitted in them trades the channel the spread made cheap
     against the one that costs most in noise units. Judged against the named model as it
-    was fitted, a time skew took 0.21 of a Maxwell branch's remaining gap on the other
-    stand (seed 2, both weights), where the named model refitted in the same units is
-    what the effect must beat.
+    was fitted, the other stand's light single effects of seed 2 had string modes named
+    beside a side load, a branch beside a dial gauge and a pulley jump beside a time
+    skew; against the named model refitted in the same units, none.
     """
     res = short_fit(fitted.result.candidate, traces, nominal, fitted.result.values)
     outs = outputs_of(res.candidate, res.values, traces, nominal)
