@@ -317,13 +317,13 @@ def further_effect(
     sizes = [float(len(c.params)) for c in candidates]
     if memo.reference is None:
         sizes.append(float(len(current.result.candidate.params)))
-    done = in_lanes(refit_on_top, sizes)
-    for effect, fitted in zip(new, done, strict=False):
+    done = in_lanes(refit_on_top, sizes)  # the tries, then the reference where it is new
+    for effect, fitted in zip(new, done[: len(new)], strict=True):
         memo.fits[effect] = fitted
         sims += fitted.result.evaluations
     if memo.reference is None:
-        memo.reference = done[-1]
-        sims += done[-1].result.evaluations
+        memo.reference = done[len(new)]
+        sims += memo.reference.result.evaluations
     base = memo.reference
     fits = {effect: memo.fits[effect] for effect in tries}
     evidence = judge(traces, base.outputs, {e: f.outputs for e, f in fits.items()})
