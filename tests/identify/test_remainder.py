@@ -278,11 +278,12 @@ def test_the_remainder_is_fitted_in_the_units_of_the_model_s_miss(
     stand: StandConfig, clean_heavy: list[Trace]
 ) -> None:
     # A model that misses u far more than F (its u 5 % short, as a dial gauge reading
-    # long would leave it): fitted in noise units pooled over the samples, a kind could
-    # give up F, the channel the model meets, for a sliver of u; the held-out error pools
-    # the channels as a geometric mean. In the units of the model's miss none takes F's
-    # held-out error past the model's by more than a tenth (``other``, the training
-    # cycles' mean, is no fit: it carries their noise in both channels alike).
+    # long would leave it): fitted in noise units pooled over the samples, every kind gave
+    # up F, the channel the model meets, for u, though the held-out error pools the
+    # channels as a geometric mean. In the units of the model's miss none takes F's
+    # held-out error past the model's by more than a tenth, and the best lowers the pooled
+    # error (``other``, the training cycles' mean, is no fit: it carries their noise in
+    # both channels alike).
     nominal = stand.stand_params("final", HEAVY)
     values = fit(Candidate.build(), clean_heavy, nominal).values
     right = outputs_of(Candidate.build(), values, clean_heavy, nominal)
@@ -294,13 +295,15 @@ def test_the_remainder_is_fitted_in_the_units_of_the_model_s_miss(
     ]
     for kind in fitted:
         assert heldout_excess(clean_heavy, kind.outputs, ("F",)) < 1.1 * f_before, kind.name
+    pooled = heldout_excess(clean_heavy, short)
+    assert min(heldout_excess(clean_heavy, kind.outputs) for kind in fitted) < 0.97 * pooled
     in_noise = fit_signatures(clean_heavy, short, nominal, values)
-    worst = max(
+    least = min(
         heldout_excess(clean_heavy, kind.outputs, ("F",))
         for kind in in_noise
         if kind.kind != "other"
     )
-    assert worst > 1.5 * f_before  # what the noise units did
+    assert least > 2 * f_before  # what the noise units did: every kind gave up F
 
 
 def test_signatures_are_judged_as_a_family_against_the_model(
