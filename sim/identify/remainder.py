@@ -120,15 +120,17 @@ def judge_signatures(
     nominal: StandParams,
     values: dict[str, float],
     balances: bool = False,
+    in_miss_units: bool = False,
 ) -> tuple[list[Signature], dict[str, SignatureFit], dict[str, Evidence]]:
     """Every signature variant fitted to the remainder of ``outputs``, judged as a family.
 
     ``balances``: the force balances' variants too (``balance``; only where no effect is
     named: they know none), in the same family — the same held-out blocks, the same
-    sign flips. Returns the signatures (those that pass first), the output-space fits
-    and the evidence, by name (a kind and where it acts).
+    sign flips. ``in_miss_units``: the variants fitted in the units of the model's miss
+    (``signature.fit_signatures``). Returns the signatures (those that pass first), the
+    output-space fits and the evidence, by name (a kind and where it acts).
     """
-    fits = {f.name: f for f in fit_signatures(traces, outputs, nominal, values)}
+    fits = {f.name: f for f in fit_signatures(traces, outputs, nominal, values, in_miss_units)}
     names = list(fits)
     rows = [block_gains(traces, outputs, fits[n].outputs) for n in names]
     x_before = heldout_excess(traces, outputs)
@@ -230,7 +232,12 @@ def remainder_of(
     against (``adequacy``; it decides only where nothing is ``named``); None: not.
     Returns the remainder and the simulations spent.
     """
-    signatures, fits, _ = judge_signatures(traces, outputs, nominal, values, balances)
+    # In the units of the model's miss: the held-out test pools each recording's channels
+    # as a geometric mean, and a fit in noise units gave up the one the model met for the
+    # one it missed most.
+    signatures, fits, _ = judge_signatures(
+        traces, outputs, nominal, values, balances, in_miss_units=True
+    )
     excess = heldout_excess(traces, outputs)
     own, sims = (
         own_excess(candidate, values, traces, nominal, excess)
