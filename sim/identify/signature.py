@@ -54,7 +54,9 @@ from sim.params import StandParams
 
 FloatArray = NDArray[np.float64]
 
-__all__ = ["KINDS", "Signature", "SignatureFit", "fit_signatures", "fit_together"]
+__all__ = [
+    "KINDS", "Signature", "SignatureFit", "fit_baseline_terms", "fit_signatures", "fit_together",
+]  # fmt: skip
 
 #: The kinds of term a remainder can be described by (``other``: repeats, no formula).
 KINDS = ("position", "strain", "velocity", "resonance", "drift", "other")
@@ -622,6 +624,23 @@ def fit_signatures(
         )
     )  # fmt: skip
     return fits
+
+
+def fit_baseline_terms(
+    traces: Sequence[Trace],
+    outputs: Sequence[Outputs],
+    nominal: StandParams,
+    values: dict[str, float],
+    in_miss_units: bool = False,
+) -> SignatureFit:
+    """The baseline's own terms alone (k·e, c·ė, friction) refitted to the remainder.
+
+    Every kind is fitted beside them (``_Remainder.fit``), so what they gain alone is no
+    kind's: the reference a kind must beat (``remainder.judge_signatures``).
+    """
+    remainder = _Remainder(traces, outputs, nominal, values, in_miss_units)
+    none = [(np.zeros((0, tr.samples)), np.zeros((0, tr.samples))) for tr in traces]
+    return remainder.fit([], none, NUISANCE, "u+F")
 
 
 def fit_together(

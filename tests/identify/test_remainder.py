@@ -306,6 +306,28 @@ def test_the_remainder_is_fitted_in_the_units_of_the_model_s_miss(
     assert least > 2 * f_before  # what the noise units did: every kind gave up F
 
 
+def test_a_kind_must_gain_beyond_the_baseline_s_own_terms(
+    stand: StandConfig, clean_heavy: list[Trace]
+) -> None:
+    # Every kind is fitted beside the baseline's own terms (k·e, c·ė, friction). Judged
+    # against the model, a model 1 % too stiff let every kind pass on what those terms
+    # gain alone; judged against them refitted alone, a drift, a velocity law or a
+    # position term adds nothing and does not pass.
+    nominal = stand.stand_params("final", HEAVY)
+    values = fit(Candidate.build(), clean_heavy, nominal).values
+    stiff = {**values, "stiffness_scale": 1.01 * values["stiffness_scale"]}
+    outputs = outputs_of(Candidate.build(), stiff, clean_heavy, nominal)
+
+    def passing(beyond: bool) -> set[str]:
+        signatures, _, _ = judge_signatures(
+            clean_heavy, outputs, nominal, stiff, in_miss_units=True, beyond_baseline_terms=beyond
+        )
+        return {s.kind for s in signatures if s.passes and s.kind != "other"}
+
+    assert passing(False) >= {"position", "velocity", "drift", "strain", "resonance"}
+    assert not passing(True) & {"position", "velocity", "drift"}
+
+
 def test_signatures_are_judged_as_a_family_against_the_model(
     stand: StandConfig, clean_heavy: list[Trace]
 ) -> None:
