@@ -147,7 +147,8 @@ def judge_signatures(
     reference = {n: outputs for n in names}
     if beyond_baseline_terms:
         terms = fit_baseline_terms(traces, outputs, nominal, values, in_miss_units).outputs
-        reference.update({n: terms for n in names if fits[n].kind != "other"})  # no fit
+        # ``other`` (the training cycles' mean) is no fit beside them: against the model.
+        reference.update({n: terms for n in names if fits[n].kind != "other"})
     rows = [block_gains(traces, reference[n], fits[n].outputs) for n in names]
     x_after = {n: heldout_excess(traces, fits[n].outputs) for n in names}
     before = {n: heldout_excess(traces, reference[n]) for n in names}
@@ -247,9 +248,9 @@ def remainder_of(
     against (``adequacy``; it decides only where nothing is ``named``); None: not.
     Returns the remainder and the simulations spent.
     """
-    # In the units of the model's miss: the held-out test pools each recording's channels
+    # In the units of the model's miss (the held-out test pools each recording's channels
     # as a geometric mean, and a fit in noise units gave up the one the model met for the
-    # one it missed most.
+    # one it missed most), each kind against the baseline's own terms refitted alone.
     signatures, fits, _ = judge_signatures(
         traces, outputs, nominal, values, balances, in_miss_units=True, beyond_baseline_terms=True
     )
