@@ -22,8 +22,8 @@ INFO = EffectInfo(
     ),
     # Richer forms: a friction growing with another power of the tension, a speed
     # dependence. (Not the fibre's law beyond linear, "strain": a tension the fibre
-    # lacks is no friction on the weight, and it described a branch, string modes or a
-    # pulley's inertia behind a side load as well as they did, and set them aside.)
+    # lacks is no friction on the weight; behind the other stand's light side load it
+    # set aside the string modes, a branch and a pulley's inertia alike.)
     richer=(("friction", "u+F"), ("velocity", "u+F")),
 )
 # fmt: on
