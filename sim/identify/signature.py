@@ -26,9 +26,11 @@ tension), drift (slow polynomials in time within each recording), and ``other``:
 remainder of the training cycles, averaged cycle by cycle, predicting the held-out
 cycles' — it repeats with the motion, yet no term of the library describes it.
 
-One more kind serves only as a named effect's richer form (``RICHER_ONLY``), never as a
+Two more kinds serve only as a named effect's richer form (``RICHER_ONLY``), never as a
 remainder's signature: relaxation, a bank of Maxwell branches (``RELAXATION_S``) beside a
-named one, since a carbon tow's relaxation spectrum is broader than one time constant.
+named one, since a carbon tow's relaxation spectrum is broader than one time constant;
+friction, a force against the weight's motion growing with a power of the tension
+(``FRICTION_POWERS``), a side load's pull pressing on a contact that is not linear.
 
 Each kind is fitted by sequentially thresholded least squares (STLSQ, the optimiser of
 SINDy; Brunton, Proctor and Kutz 2016), on columns scaled to their output's noise so the
@@ -91,9 +93,13 @@ RESONANCE_ZETA = 0.05
 #: spectrum is broad (its sizing's glassy response in milliseconds, the tow settling in
 #: tenths of a second).
 RELAXATION_S = (0.002, 0.005, 0.01, 0.02, 0.05, 0.1, 0.2, 0.5)
+#: Powers of the tension in a friction that grows with it (``RICHER_ONLY``): a wall the
+#: fibre's pull presses the weight on, its contact not linear in the load.
+FRICTION_POWERS = (0.5, 1.0, 2.0)
 #: Kinds that only a named effect's richer form uses (``EffectInfo.richer``), never a
-#: remainder's signature: one more relaxation branch is the catalogue's own effect.
-RICHER_ONLY = ("relaxation",)
+#: remainder's signature: one more relaxation branch is the catalogue's own effect, and
+#: a friction that grows with a power of the tension is the side load's.
+RICHER_ONLY = ("relaxation", "friction")
 #: Speeds at which the velocity library's friction shapes saturate, m/s.
 VELOCITY_SCALES_M_S = (1e-3, 1e-2)
 #: Polynomial orders of the drift library (per recording and gauge).
@@ -291,6 +297,11 @@ class _Library:
                 for hz in RESONANCE_HZ
                 for route in ("tension", "F")
             ]
+        if kind == "friction":  # on the weight, against its motion, growing with T^p
+            v_reg = f"{self.v_reg * 1e3:.3g} mm/s"
+            return [
+                Term(kind, "weight", f"(T/{t})^{p:g}·tanh(v/{v_reg})", "N") for p in FRICTION_POWERS
+            ]
         if kind == "relaxation":  # one more Maxwell branch: k·ė relaxing with τ
             return [
                 Term(kind, "tension", f"k·branch(τ {tau * 1e3:g} ms)", "N") for tau in RELAXATION_S
@@ -332,6 +343,9 @@ class _Library:
             for hz in RESONANCE_HZ:
                 mode = _mode_response(out.force_n, hz, tr.rate_hz)
                 rows += [mode, mode]
+        elif kind == "friction":
+            load = np.maximum(out.force_n, 0.0) / self.t_ref
+            rows += [load**p * np.tanh(v / self.v_reg) for p in FRICTION_POWERS]
         elif kind == "relaxation":
             e = self.elongation(i)
             rows += [self.k * _branch_response(e - e[0], tau, tr.rate_hz) for tau in RELAXATION_S]

@@ -20,7 +20,10 @@ INFO = EffectInfo(
               "μ_s, friction coefficient of the guide wall", bounds=(0.0, 0.8),
               why="steel or aluminium on a dry guide wall: up to 0.6–0.8"),
     ),
-    # Richer forms: another exponent of the tension, a speed dependence.
-    richer=(("strain", "u+F"), ("velocity", "u+F")),
+    # Richer forms: a friction growing with another power of the tension, a speed
+    # dependence. (Not the fibre's law beyond linear, "strain": a tension the fibre
+    # lacks is no friction on the weight; behind the other stand's light side load it
+    # set aside the string modes, a branch and a pulley's inertia alike.)
+    richer=(("friction", "u+F"), ("velocity", "u+F")),
 )
 # fmt: on
