@@ -168,8 +168,8 @@ def test_a_side_load_s_richer_form_is_a_friction_growing_with_the_tension(
     # baseline): what remains is a friction against the weight's motion that grows with
     # the tension. The side load's richer form describes it beyond what the baseline's
     # own terms refitted do, and better than the fibre's law beyond linear (its richer
-    # form before, which is no friction and also described the string modes, a branch
-    # or a pulley's inertia behind a side load): X 81 → 39 against 48 and 60.
+    # form before, which is no friction; behind the other stand's light side load it set
+    # the string modes, a branch and a pulley's inertia aside): X 81 → 39 against 48, 60.
     nominal = stand.stand_params("final", HEAVY)
     values = {"stiffness_scale": 1.0, "damping_scale": 1.0, "friction_scale": 1.0}
     drives, _, _ = make_campaign(stand, "none", HEAVY, np.random.default_rng(5), FULL_CAMPAIGN[1:3])
