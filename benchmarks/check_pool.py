@@ -10,8 +10,9 @@ so a run stopped early keeps what finished. Cap every worker's thread pools firs
 
 A group is ``TRUTH:SEED`` (every class, both weights), ``TRUTH:SEED:pairs`` or
 ``:triples`` (the standard several-effect campaigns, ``other`` only), or
-``TRUTH:SEED:A,B`` (those classes). ``--summary FILE.jsonl`` scores a finished file
-(``CheckResult.to_dict()`` per group, and the groups together).
+``TRUTH:SEED:A,B`` (those classes); ``--only TEXT`` keeps the campaigns whose name holds
+TEXT (``--only '!TEXT'``: those without it). ``--summary FILE.jsonl`` scores a finished
+file (``CheckResult.to_dict()`` per group, and the groups together).
 """
 
 from __future__ import annotations
@@ -69,9 +70,16 @@ def campaigns(groups: list[str]) -> list[tuple[str, Any, Any]]:
     return work
 
 
-def run(out: Path, workers: int, groups: list[str]) -> None:
+def kept(name: str, only: str | None) -> bool:
+    """Whether ``--only`` keeps a campaign: its name holds the text (``!TEXT``: does not)."""
+    if only is None:
+        return True
+    return only[1:] not in name if only.startswith("!") else only in name
+
+
+def run(out: Path, workers: int, groups: list[str], only: str | None = None) -> None:
     """Run the campaigns, appending a line per finished one to ``out``."""
-    work = campaigns(groups)
+    work = [w for w in campaigns(groups) if kept(w[2].name, only)]
     print(f"{len(work)} campaigns on {workers} workers", flush=True)
     started = time.time()
     with out.open("a") as sink, ProcessPoolExecutor(workers) as pool:
@@ -112,11 +120,14 @@ def main() -> None:
     parser.add_argument("workers", type=int, nargs="?", default=1)
     parser.add_argument("groups", nargs="*")
     parser.add_argument("--summary", action="store_true", help="score OUT instead of running")
+    parser.add_argument(
+        "--only", metavar="TEXT", help="only campaigns whose name holds TEXT (!TEXT: without it)"
+    )
     args = parser.parse_args()
     if args.summary:
         print(json.dumps(summary(args.out), indent=1))
     else:
-        run(args.out, args.workers, args.groups)
+        run(args.out, args.workers, args.groups, args.only)
 
 
 if __name__ == "__main__":
