@@ -91,8 +91,32 @@ def _recorded(camp: Any, spec: Any, mass: float, name: str, rng: np.random.Gener
     return make_trace(name, t, x_rec, u_rec, f_rec, mass)
 
 
-def campaign(seed: int, k: int, truth: str, mass: float, recordings: str) -> dict[str, Any]:
-    """One campaign: first diagnosis, and if ambiguous the plan, a random draw, both judged."""
+def _added(camp: Any, added: str, mass: float, rng: np.random.Generator) -> Any:
+    """One recording of another set (``SET:NAME``, ``OTHER_SETS``) on the campaign's stand."""
+    from drivers.signals import plan_motion
+    from sim.checks.otherstand import simulate
+    from sim.checks.otherstand.campaign import OTHER_SETS
+    from sim.checks.otherstand.gauges import Realism
+    from sim.config import default_config
+    from sim.identify.traces import make_trace
+
+    set_name, _, name = added.partition(":")
+    (rec,) = [r for r in OTHER_SETS[set_name] if r.name == name]
+    rate = default_config().sample_rate_hz
+    t, x = plan_motion(rec.signal, rec.limits).sample(rate)
+    run = simulate(camp.stand.with_(mass_kg=mass), camp.effects, x, rate)
+    x_rec, u_rec, f_rec = Realism().apply(x, run.u_m, run.force_n, rate, rng)
+    return make_trace(added, t, x_rec, u_rec, f_rec, mass)
+
+
+def campaign(
+    seed: int, k: int, truth: str, mass: float, recordings: str, added: str | None = None
+) -> dict[str, Any]:
+    """One campaign: first diagnosis, and if ambiguous the plan, a random draw, both judged.
+
+    ``added`` (``SET:NAME``): instead of the plan, that recording of another set is added
+    to each ambiguous campaign, at its own weight, and judged the same way.
+    """
     from labstand.commands.plan import noise_of
     from labstand.errors import CommandError
     from labstand.fitted import fitted_from_dict
@@ -116,7 +140,12 @@ def campaign(seed: int, k: int, truth: str, mass: float, recordings: str) -> dic
         "params": camp.effects, "first": _answer(first),
     }  # fmt: skip
     out["ambiguous"] = bool(out["first"]["rivals"]) or not right(truth, out["first"])
-    if out["ambiguous"]:
+    if out["ambiguous"] and added is not None:
+        extra = _added(camp, added, mass, np.random.default_rng([seed, k, 2]))
+        again = _answer(_diagnosis([*traces, extra], config.stand_params("final")))
+        out["added"] = {**again, "motion": added, "right": right(truth, again),
+                        "settled": settled(truth, again)}  # fmt: skip
+    elif out["ambiguous"]:
         fitted = fitted_from_dict(first, Path("(first diagnosis)"))
         rule = SlackRule(2.0, 0.25)
         masses = sorted(config.weights_kg.values())
@@ -148,6 +177,16 @@ def summary(lines: Sequence[dict[str, Any]]) -> dict[str, Any]:
     """Counts over the ambiguous campaigns: planned and random, right and settled."""
     ambiguous = [r for r in lines if r["ambiguous"]]
     counted = [r for r in ambiguous if "planned" in r]
+    added = [r for r in ambiguous if "added" in r]
+    if added:  # ``--added``: that recording instead of a plan
+        return {
+            "campaigns": len(lines),
+            "ambiguous": len(ambiguous),
+            **{
+                f"added_{what}": sum(r["added"][what] for r in added)
+                for what in ("right", "settled")
+            },
+        }
     return {
         "campaigns": len(lines),
         "ambiguous": len(ambiguous),
@@ -183,6 +222,9 @@ def main() -> None:
     parser.add_argument("--jobs", type=int, default=1, help="campaigns at once (processes)")
     parser.add_argument("--out", type=Path, default=Path("plan_side_by_side.jsonl"))
     parser.add_argument("--summary", type=Path, help="only print the counts of this file")
+    parser.add_argument("--added", metavar="SET:NAME",
+                        help="instead of a plan, add this recording of another set "
+                        "(e.g. moderate:burst) to each ambiguous campaign")  # fmt: skip
     args = parser.parse_args()
     if args.summary is not None:
         print(json.dumps(summary(_read(args.summary)), indent=2))
@@ -196,7 +238,7 @@ def main() -> None:
     done = {(r["seed"], r["campaign"]) for r in _read(args.out)}
     todo = [
         (args.seed, k, truths[k % len(truths)], masses[(k // len(truths)) % len(masses)],
-         args.recordings)
+         args.recordings, args.added)
         for k in range(args.campaigns) if (args.seed, k) not in done
     ]  # fmt: skip
     if args.only:
@@ -216,7 +258,9 @@ def main() -> None:
             sink.flush()
             mark = ("planned " + ("right" if line["planned"]["right"] else "wrong")
                     + ", random " + ("right" if line["random"]["right"] else "wrong")
-                    if "planned" in line else "not ambiguous" if not line["ambiguous"]
+                    if "planned" in line
+                    else f"{args.added} " + ("right" if line["added"]["right"] else "wrong")
+                    if "added" in line else "not ambiguous" if not line["ambiguous"]
                     else "no plan")  # fmt: skip
             print(f"campaign {line['campaign']} ({line['truth']}, {line['mass_kg']:g} kg, "
                   f"{line['seconds']:.0f} s): first {line['first']['named']} "

@@ -128,6 +128,24 @@ def test_a_branch_stretch_relaxes_with_its_time_and_holds_rate_times_tau() -> No
     assert ramp[-1] == pytest.approx(0.01 * tau, rel=1e-3)
 
 
+def _heavy_recordings(stand: StandConfig, true: list[EffectSpec]) -> list[Trace]:
+    """The stand's heavy medium and slow recordings of a model with ``true`` effects.
+
+    At the nominal (``final``) stand, read with 2 µm and 0.05 N of noise.
+    """
+    nominal = stand.stand_params("final", HEAVY)
+    drives, _, _ = make_campaign(stand, "none", HEAVY, np.random.default_rng(5), FULL_CAMPAIGN[1:3])
+    rng = np.random.default_rng(7)
+    read = []
+    for tr in drives:
+        run = Model(nominal, true).run(tr.x_m, tr.rate_hz)
+        u = run.u_m - run.u_m[0] + rng.normal(0.0, 2e-6, tr.samples)
+        f = run.force_n + rng.normal(0.0, 0.05, tr.samples)
+        t = np.arange(tr.samples) / tr.rate_hz
+        read.append(make_trace(tr.name, t, tr.x_m, u, f, HEAVY))
+    return read
+
+
 def test_one_more_relaxation_branch_describes_a_missing_branch_best_of_the_forms(
     stand: StandConfig,
 ) -> None:
@@ -142,15 +160,7 @@ def test_one_more_relaxation_branch_describes_a_missing_branch_best_of_the_forms
     branch = EffectSpec("fibre_viscoelastic",
                         {"branch_stiffness_n_m": 0.2 * k, "relaxation_time_s": 0.02})  # fmt: skip
     values = {"stiffness_scale": 1.0, "damping_scale": 1.0, "friction_scale": 1.0}
-    drives, _, _ = make_campaign(stand, "none", HEAVY, np.random.default_rng(5), FULL_CAMPAIGN[1:3])
-    rng = np.random.default_rng(7)
-    read = []
-    for tr in drives:
-        run = Model(nominal, [branch]).run(tr.x_m, tr.rate_hz)
-        u = run.u_m - run.u_m[0] + rng.normal(0.0, 2e-6, tr.samples)
-        f = run.force_n + rng.normal(0.0, 0.05, tr.samples)
-        t = np.arange(tr.samples) / tr.rate_hz
-        read.append(make_trace(tr.name, t, tr.x_m, u, f, HEAVY))
+    read = _heavy_recordings(stand, [branch])
     outputs = outputs_of(Candidate.build(), values, read, nominal)
     x_before = heldout_excess(read, outputs)
     x_after = {}
@@ -172,16 +182,7 @@ def test_a_side_load_s_richer_form_is_a_friction_growing_with_the_tension(
     # the string modes, a branch and a pulley's inertia aside): X 81 → 39 against 48, 60.
     nominal = stand.stand_params("final", HEAVY)
     values = {"stiffness_scale": 1.0, "damping_scale": 1.0, "friction_scale": 1.0}
-    drives, _, _ = make_campaign(stand, "none", HEAVY, np.random.default_rng(5), FULL_CAMPAIGN[1:3])
-    true = [EffectSpec("side_load_friction", {"friction_coeff": 0.2})]
-    rng = np.random.default_rng(7)
-    read = []
-    for tr in drives:
-        run = Model(nominal, true).run(tr.x_m, tr.rate_hz)
-        u = run.u_m - run.u_m[0] + rng.normal(0.0, 2e-6, tr.samples)
-        f = run.force_n + rng.normal(0.0, 0.05, tr.samples)
-        t = np.arange(tr.samples) / tr.rate_hz
-        read.append(make_trace(tr.name, t, tr.x_m, u, f, HEAVY))
+    read = _heavy_recordings(stand, [EffectSpec("side_load_friction", {"friction_coeff": 0.2})])
     named = dict(values, **{"side_load_friction.friction_coeff": 0.1})
     outputs = outputs_of(Candidate.build("side_load_friction"), named, read, nominal)
     x_before = heldout_excess(read, outputs)
