@@ -75,8 +75,13 @@ def _diagnosis(traces: Sequence[Any], nominal: Any) -> dict[str, Any]:
     return result
 
 
-def _recorded(camp: Any, spec: Any, mass: float, name: str, rng: np.random.Generator) -> Any:
-    """One more recording of the campaign's true stand (its effects, the other weight too)."""
+def _recorded(
+    camp: Any, spec: Any, mass: float, name: str, rng: np.random.Generator, limits: Any = None
+) -> Any:
+    """One more recording of the campaign's true stand (its effects, the other weight too).
+
+    ``limits``: the drive's (default: the stand file's).
+    """
     from drivers.signals import plan_motion
     from sim.checks.otherstand import simulate
     from sim.checks.otherstand.gauges import Realism
@@ -85,7 +90,7 @@ def _recorded(camp: Any, spec: Any, mass: float, name: str, rng: np.random.Gener
 
     config = default_config()
     rate = config.sample_rate_hz
-    t, x = plan_motion(spec, config.drive).sample(rate)
+    t, x = plan_motion(spec, limits or config.drive).sample(rate)
     run = simulate(camp.stand.with_(mass_kg=mass), camp.effects, x, rate)
     x_rec, u_rec, f_rec = Realism().apply(x, run.u_m, run.force_n, rate, rng)
     return make_trace(name, t, x_rec, u_rec, f_rec, mass)
@@ -93,20 +98,11 @@ def _recorded(camp: Any, spec: Any, mass: float, name: str, rng: np.random.Gener
 
 def _added(camp: Any, added: str, mass: float, rng: np.random.Generator) -> Any:
     """One recording of another set (``SET:NAME``, ``OTHER_SETS``) on the campaign's stand."""
-    from drivers.signals import plan_motion
-    from sim.checks.otherstand import simulate
     from sim.checks.otherstand.campaign import OTHER_SETS
-    from sim.checks.otherstand.gauges import Realism
-    from sim.config import default_config
-    from sim.identify.traces import make_trace
 
     set_name, _, name = added.partition(":")
     (rec,) = [r for r in OTHER_SETS[set_name] if r.name == name]
-    rate = default_config().sample_rate_hz
-    t, x = plan_motion(rec.signal, rec.limits).sample(rate)
-    run = simulate(camp.stand.with_(mass_kg=mass), camp.effects, x, rate)
-    x_rec, u_rec, f_rec = Realism().apply(x, run.u_m, run.force_n, rate, rng)
-    return make_trace(added, t, x_rec, u_rec, f_rec, mass)
+    return _recorded(camp, rec.signal, mass, added, rng, rec.limits)
 
 
 def campaign(
