@@ -222,6 +222,13 @@ def main() -> None:
                         help="instead of a plan, add this recording of another set "
                         "(e.g. moderate:burst) to each ambiguous campaign")  # fmt: skip
     args = parser.parse_args()
+    if args.added is not None:
+        from sim.checks.otherstand.campaign import OTHER_SETS
+
+        set_name, _, name = args.added.partition(":")
+        if name not in {r.name for r in OTHER_SETS.get(set_name, ())}:
+            known = ", ".join(f"{s}:{r.name}" for s, rs in OTHER_SETS.items() for r in rs)
+            parser.error(f"--added {args.added!r}: not a recording of the other stand ({known})")
     if args.summary is not None:
         print(json.dumps(summary(_read(args.summary)), indent=2))
         return
