@@ -46,11 +46,19 @@ CATALOGUE = (
 BUDGET_S = 120.0
 
 
+#: What each ranked candidate's entry keeps of the diagnosis' ranking.
+REFIT_KEYS = ("params", "p_value", "p_family", "heldout_excess", "at_bound")
+
+
 def _answer(d: dict[str, Any]) -> dict[str, Any]:
     named = [e["effect"] for e in d["effects"]]
     rivals = d["effects"][0]["indistinguishable_from"] if named else []
     ranked = [r["effect"] for r in d["ranking"]]
-    return {"verdict": d["verdict"], "named": named, "rivals": rivals, "ranking": ranked}
+    # Each candidate's own refit as the planner takes it (its rival's size) and the
+    # evidence for it: what a look at why a plan failed starts from.
+    refits = {r["effect"]: {key: r.get(key) for key in REFIT_KEYS} for r in d["ranking"]}
+    return {"verdict": d["verdict"], "named": named, "rivals": rivals, "ranking": ranked,
+            "refits": refits}  # fmt: skip
 
 
 def right(truth: str, answer: dict[str, Any]) -> bool:
@@ -155,7 +163,9 @@ def campaign(
         plan = answer.plan
         out["plan"] = {"why": answer.line(), "expected_separation": plan.expected_separation,
                        "separates": {f"{a} / {b}": v for (a, b), v in plan.separations.items()},
-                       "admissible": plan.admissible, "complete": plan.complete}  # fmt: skip
+                       "admissible": plan.admissible, "complete": plan.complete,
+                       "rivals": {r.name: [str(e) for e in r.effects]
+                                  for r in setting.rivals}}  # fmt: skip
         if plan.best is not None:
             drawn = plan.options[int(np.random.default_rng([seed, k, 1]).integers(plan.admissible))]
             drawn = as_planned(setting, drawn)  # run as long as a plan runs
