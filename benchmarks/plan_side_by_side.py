@@ -104,12 +104,19 @@ def _recorded(
     return make_trace(name, t, x_rec, u_rec, f_rec, mass)
 
 
-def _added(camp: Any, added: str, mass: float, rng: np.random.Generator) -> Any:
-    """One recording of another set (``SET:NAME``, ``OTHER_SETS``) on the campaign's stand."""
+def _other_recording(added: str) -> Any | None:
+    """The other stand's recording ``SET:NAME`` (``OTHER_SETS``), None if there is none."""
     from sim.checks.otherstand.campaign import OTHER_SETS
 
     set_name, _, name = added.partition(":")
-    (rec,) = [r for r in OTHER_SETS[set_name] if r.name == name]
+    return next((r for r in OTHER_SETS.get(set_name, ()) if r.name == name), None)
+
+
+def _added(camp: Any, added: str, mass: float, rng: np.random.Generator) -> Any:
+    """One recording of another set (``SET:NAME``) on the campaign's stand."""
+    rec = _other_recording(added)
+    if rec is None:  # ``main`` refuses it before any campaign runs
+        raise ValueError(f"not a recording of the other stand: {added!r}")
     return _recorded(camp, rec.signal, mass, added, rng, rec.limits)
 
 
@@ -232,13 +239,11 @@ def main() -> None:
                         help="instead of a plan, add this recording of another set "
                         "(e.g. moderate:burst) to each ambiguous campaign")  # fmt: skip
     args = parser.parse_args()
-    if args.added is not None:
+    if args.added is not None and _other_recording(args.added) is None:
         from sim.checks.otherstand.campaign import OTHER_SETS
 
-        set_name, _, name = args.added.partition(":")
-        if name not in {r.name for r in OTHER_SETS.get(set_name, ())}:
-            known = ", ".join(f"{s}:{r.name}" for s, rs in OTHER_SETS.items() for r in rs)
-            parser.error(f"--added {args.added!r}: not a recording of the other stand ({known})")
+        known = ", ".join(f"{s}:{r.name}" for s, rs in OTHER_SETS.items() for r in rs)
+        parser.error(f"--added {args.added!r}: not a recording of the other stand ({known})")
     if args.summary is not None:
         print(json.dumps(summary(_read(args.summary)), indent=2))
         return
